@@ -1,0 +1,48 @@
+//! Fitting engines. Every engine (subdivision surfaces, B-spline surfaces and curves) is driven
+//! the same way through [`Fitter`]: build it from data and options, call [`Fitter::step`] for one
+//! iteration (the page animates this) or [`Fitter::run`] to the end, and read statistics and
+//! per-point errors at any time.
+
+mod error;
+mod stats;
+
+pub use error::FitError;
+pub use stats::{ErrorStats, IterationRecord, Tolerances};
+
+/// What one call of [`Fitter::step`] left the fit in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitStatus {
+    /// Tolerances not met yet; more iterations may help.
+    Running,
+    /// Every tolerance given is met.
+    Converged,
+    /// The iteration cap was reached first.
+    MaxIterations,
+}
+
+/// The interface every fitting engine offers.
+pub trait Fitter {
+    /// Runs one iteration (foot points, error vectors, control-point moves; refinement when due).
+    fn step(&mut self) -> Result<FitStatus, FitError>;
+
+    /// Iterates until converged or out of iterations.
+    fn run(&mut self) -> Result<FitStatus, FitError> {
+        loop {
+            match self.step()? {
+                FitStatus::Running => {}
+                done => return Ok(done),
+            }
+        }
+    }
+
+    /// One record per iteration so far; the last is the current state.
+    fn history(&self) -> &[IterationRecord];
+
+    /// Signed distance of every data point to the current surface, in model units (positive on
+    /// the side the surface normal points to), in data order.
+    fn point_errors(&self) -> &[f64];
+
+    /// Error statistics of the current surface.
+    fn stats(&self) -> ErrorStats;
+}

@@ -1,0 +1,127 @@
+use serde::{Deserialize, Serialize};
+
+/// Stopping tolerances, each in % of the data's bounding-box diagonal. A fit stops when every
+/// tolerance given is met. With none given, the defaults of the specification apply
+/// (E_avg 0.01 %, E_max 0.05 %).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Tolerances {
+    /// Bound on E_avg (mean distance), %.
+    pub avg_pct: Option<f64>,
+    /// Bound on E_max (largest distance), %.
+    pub max_pct: Option<f64>,
+    /// Bound on E_rms (root-mean-square distance), %.
+    pub rms_pct: Option<f64>,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances {
+            avg_pct: Some(0.01),
+            max_pct: Some(0.05),
+            rms_pct: None,
+        }
+    }
+}
+
+impl Tolerances {
+    /// Whether `stats` meets every tolerance given.
+    pub fn met_by(&self, stats: &ErrorStats) -> bool {
+        let ok = |tol: Option<f64>, value: f64| tol.is_none_or(|t| value <= t);
+        ok(self.avg_pct, stats.e_avg_pct)
+            && ok(self.max_pct, stats.e_max_pct)
+            && ok(self.rms_pct, stats.e_rms_pct)
+    }
+}
+
+/// Point-to-surface distance statistics. The `_pct` figures are % of the data's bounding-box
+/// diagonal, the others are in model units.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ErrorStats {
+    /// Mean distance, model units.
+    pub e_avg: f64,
+    /// Largest distance, model units.
+    pub e_max: f64,
+    /// Root-mean-square distance, model units.
+    pub e_rms: f64,
+    /// E_avg in % of the bounding-box diagonal.
+    pub e_avg_pct: f64,
+    /// E_max in % of the bounding-box diagonal.
+    pub e_max_pct: f64,
+    /// E_rms in % of the bounding-box diagonal.
+    pub e_rms_pct: f64,
+}
+
+impl ErrorStats {
+    /// Statistics of unsigned or signed `distances` (absolute values are used), relative to a
+    /// bounding-box `diagonal`. Empty input gives zeros.
+    pub fn from_distances(distances: &[f64], diagonal: f64) -> ErrorStats {
+        if distances.is_empty() {
+            return ErrorStats::default();
+        }
+        let n = distances.len() as f64;
+        let (mut sum, mut sum_sq, mut max) = (0.0, 0.0, 0.0f64);
+        for d in distances.iter().map(|d| d.abs()) {
+            sum += d;
+            sum_sq += d * d;
+            max = max.max(d);
+        }
+        let pct = if diagonal > 0.0 {
+            100.0 / diagonal
+        } else {
+            0.0
+        };
+        let (e_avg, e_rms) = (sum / n, (sum_sq / n).sqrt());
+        ErrorStats {
+            e_avg,
+            e_max: max,
+            e_rms,
+            e_avg_pct: e_avg * pct,
+            e_max_pct: max * pct,
+            e_rms_pct: e_rms * pct,
+        }
+    }
+}
+
+/// The state after one iteration, as the report's `history` lists it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IterationRecord {
+    /// Iteration number, from 1.
+    pub iter: usize,
+    /// Control points after the iteration.
+    pub control_points: usize,
+    /// E_avg, %.
+    pub e_avg_pct: f64,
+    /// E_max, %.
+    pub e_max_pct: f64,
+    /// E_rms, %.
+    pub e_rms_pct: f64,
+    /// Wall time of the iteration, ms.
+    pub ms: f64,
+    /// Whether the control mesh was refined (or knots inserted) in this iteration.
+    pub refined: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_and_tolerances() {
+        let s = ErrorStats::from_distances(&[0.0, -3.0, 4.0], 100.0);
+        assert!((s.e_avg - 7.0 / 3.0).abs() < 1e-12);
+        assert_eq!(s.e_max, 4.0);
+        assert!((s.e_rms - (25.0f64 / 3.0).sqrt()).abs() < 1e-12);
+        assert!((s.e_max_pct - 4.0).abs() < 1e-12);
+        let tol = Tolerances {
+            avg_pct: Some(3.0),
+            max_pct: Some(4.0),
+            rms_pct: None,
+        };
+        assert!(tol.met_by(&s));
+        assert!(!Tolerances {
+            max_pct: Some(3.9),
+            ..tol
+        }
+        .met_by(&s));
+    }
+}

@@ -1,0 +1,10 @@
+//! Geometric primitives in f64: points, vectors, axis-aligned boxes.
+
+mod aabb;
+
+pub use aabb::Aabb;
+
+/// A point in 3D space (f64). An alias of glam's `DVec3`, so points and vectors share maths.
+pub type Point3 = glam::DVec3;
+/// A vector in 3D space (f64).
+pub type Vec3 = glam::DVec3;

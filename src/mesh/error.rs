@@ -1,0 +1,37 @@
+use thiserror::Error;
+
+/// Why a mesh was rejected.
+#[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum MeshError {
+    /// A vertex coordinate is NaN or infinite.
+    #[error("vertex {vertex} has a non-finite coordinate")]
+    NonFiniteVertex {
+        /// Index of the offending vertex.
+        vertex: usize,
+    },
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face} refers to vertex {index}, but the mesh has {vertex_count} vertices")]
+    IndexOutOfRange {
+        /// Index of the offending face.
+        face: usize,
+        /// The out-of-range vertex index.
+        index: u64,
+        /// Number of vertices in the mesh.
+        vertex_count: usize,
+    },
+    /// A face has fewer than three vertices.
+    #[error("face {face} has {len} vertices; a face needs at least 3")]
+    FaceTooSmall {
+        /// Index of the offending face.
+        face: usize,
+        /// Its vertex count.
+        len: usize,
+    },
+    /// The mesh has more vertices or face corners than a `u32` index can address.
+    #[error("mesh too large: {what} exceeds u32 indexing")]
+    TooLarge {
+        /// What overflowed.
+        what: &'static str,
+    },
+}

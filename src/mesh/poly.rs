@@ -1,0 +1,154 @@
+use super::MeshError;
+use crate::geom::{Aabb, Point3};
+
+/// Points with optional polygon connectivity: what every reader produces and every writer takes.
+///
+/// Invariants, checked by [`PolyMesh::try_new`]: every coordinate is finite, every face has at
+/// least three vertices, and every face index is in range. Vertices that belong to no face are
+/// allowed (scans have them, and they are data points all the same).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PolyMesh {
+    positions: Vec<Point3>,
+    /// Face `i` is `face_indices[face_starts[i]..face_starts[i + 1]]`; `face_starts[0] == 0`.
+    face_starts: Vec<u32>,
+    face_indices: Vec<u32>,
+}
+
+impl PolyMesh {
+    /// A mesh from positions and faces, checked against the invariants above.
+    pub fn try_new<F, I>(positions: Vec<Point3>, faces: F) -> Result<PolyMesh, MeshError>
+    where
+        F: IntoIterator<Item = I>,
+        I: AsRef<[u32]>,
+    {
+        if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(MeshError::NonFiniteVertex { vertex });
+        }
+        if u32::try_from(positions.len()).is_err() {
+            return Err(MeshError::TooLarge {
+                what: "vertex count",
+            });
+        }
+        let mut mesh = PolyMesh {
+            positions,
+            face_starts: vec![0],
+            face_indices: Vec::new(),
+        };
+        for (face, f) in faces.into_iter().enumerate() {
+            mesh.push_face(face, f.as_ref())?;
+        }
+        Ok(mesh)
+    }
+
+    /// Points only, no faces.
+    pub fn from_points(positions: Vec<Point3>) -> Result<PolyMesh, MeshError> {
+        PolyMesh::try_new(positions, std::iter::empty::<[u32; 3]>())
+    }
+
+    fn push_face(&mut self, face: usize, f: &[u32]) -> Result<(), MeshError> {
+        if f.len() < 3 {
+            return Err(MeshError::FaceTooSmall { face, len: f.len() });
+        }
+        let n = self.positions.len();
+        if let Some(&index) = f.iter().find(|&&i| i as usize >= n) {
+            return Err(MeshError::IndexOutOfRange {
+                face,
+                index: index.into(),
+                vertex_count: n,
+            });
+        }
+        self.face_indices.extend_from_slice(f);
+        let end = u32::try_from(self.face_indices.len()).map_err(|_| MeshError::TooLarge {
+            what: "face corner count",
+        })?;
+        self.face_starts.push(end);
+        Ok(())
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[Point3] {
+        &self.positions
+    }
+
+    /// Number of vertices (points).
+    pub fn num_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of faces (polygons of any size).
+    pub fn num_faces(&self) -> usize {
+        self.face_starts.len() - 1
+    }
+
+    /// The vertex indices of face `i`. Panics if `i >= num_faces()` (a caller bug, not bad data).
+    pub fn face(&self, i: usize) -> &[u32] {
+        &self.face_indices[self.face_starts[i] as usize..self.face_starts[i + 1] as usize]
+    }
+
+    /// All faces in order.
+    pub fn faces(&self) -> impl ExactSizeIterator<Item = &[u32]> + '_ {
+        (0..self.num_faces()).map(move |i| self.face(i))
+    }
+
+    /// Whether the mesh has no faces (a bare point set).
+    pub fn is_point_cloud(&self) -> bool {
+        self.num_faces() == 0
+    }
+
+    /// Faces fan-triangulated: an n-gon gives n − 2 triangles.
+    pub fn triangles(&self) -> Vec<[u32; 3]> {
+        let mut out =
+            Vec::with_capacity(self.face_indices.len().saturating_sub(2 * self.num_faces()));
+        for f in self.faces() {
+            for k in 1..f.len() - 1 {
+                out.push([f[0], f[k], f[k + 1]]);
+            }
+        }
+        out
+    }
+
+    /// Number of triangles that [`PolyMesh::triangles`] gives, without building them.
+    pub fn num_triangles(&self) -> usize {
+        self.faces().map(|f| f.len() - 2).sum()
+    }
+
+    /// Bounding box of all vertices, or `None` for an empty mesh.
+    pub fn bbox(&self) -> Option<Aabb> {
+        Aabb::from_points(&self.positions)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(x: f64) -> Point3 {
+        Point3::new(x, 0.0, 0.0)
+    }
+
+    #[test]
+    fn quad_triangulates_to_two() {
+        let m =
+            PolyMesh::try_new(vec![p(0.0), p(1.0), p(2.0), p(3.0)], [vec![0, 1, 2, 3]]).unwrap();
+        assert_eq!(m.num_faces(), 1);
+        assert_eq!(m.triangles(), vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(m.num_triangles(), 2);
+    }
+
+    #[test]
+    fn rejects_bad_faces_and_coordinates() {
+        let e = PolyMesh::try_new(vec![p(0.0), p(1.0), p(2.0)], [[0, 1, 5]]).unwrap_err();
+        assert!(matches!(
+            e,
+            MeshError::IndexOutOfRange {
+                face: 0,
+                index: 5,
+                vertex_count: 3
+            }
+        ));
+        let e = PolyMesh::try_new(vec![p(0.0), p(1.0)], [vec![0, 1]]).unwrap_err();
+        assert!(matches!(e, MeshError::FaceTooSmall { face: 0, len: 2 }));
+        let e = PolyMesh::from_points(vec![p(0.0), p(f64::NAN)]).unwrap_err();
+        assert!(matches!(e, MeshError::NonFiniteVertex { vertex: 1 }));
+    }
+}

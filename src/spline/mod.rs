@@ -1,0 +1,1 @@
+//! B-spline and NURBS curves and surfaces.
