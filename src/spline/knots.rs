@@ -1,0 +1,313 @@
+use super::SplineError;
+
+/// Largest supported B-spline degree. Higher degrees are numerically poor for fitting and the
+/// fixed-size scratch arrays below depend on it.
+pub const MAX_DEGREE: usize = 7;
+
+/// A non-decreasing knot sequence with its degree p. The parameter domain is
+/// `[knots[p], knots[len - p - 1]]`, and there are `len - p - 1` basis functions.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnotVector {
+    degree: usize,
+    knots: Vec<f64>,
+}
+
+impl KnotVector {
+    /// A knot vector, checked: degree 1..=[`MAX_DEGREE`], at least 2(p+1) finite non-decreasing
+    /// knots, no interior multiplicity above p + 1, and a non-empty domain.
+    pub fn try_new(degree: usize, knots: Vec<f64>) -> Result<KnotVector, SplineError> {
+        if degree == 0 || degree > MAX_DEGREE {
+            return Err(SplineError::BadDegree {
+                degree,
+                max: MAX_DEGREE,
+            });
+        }
+        let needed = 2 * (degree + 1);
+        if knots.len() < needed {
+            return Err(SplineError::TooFewKnots {
+                found: knots.len(),
+                needed,
+                degree,
+            });
+        }
+        if let Some(index) = knots.iter().position(|k| !k.is_finite()) {
+            return Err(SplineError::NonFiniteKnot { index });
+        }
+        if let Some(i) = (1..knots.len()).find(|&i| knots[i] < knots[i - 1]) {
+            return Err(SplineError::DecreasingKnots {
+                index: i,
+                prev: knots[i - 1],
+                next: knots[i],
+            });
+        }
+        check_multiplicity(degree, &knots)?;
+        let kv = KnotVector { degree, knots };
+        let (start, end) = kv.domain();
+        if end <= start {
+            return Err(SplineError::EmptyDomain { start, end });
+        }
+        Ok(kv)
+    }
+
+    /// A clamped (open) knot vector with `n` basis functions and uniform interior knots on
+    /// `[0, 1]`. `n` must be at least `degree + 1`.
+    pub fn clamped_uniform(degree: usize, n: usize) -> Result<KnotVector, SplineError> {
+        let interior = n.saturating_sub(degree + 1);
+        let mut knots = vec![0.0; degree + 1];
+        knots.extend((1..=interior).map(|i| i as f64 / (interior + 1) as f64));
+        knots.extend(std::iter::repeat_n(1.0, degree + 1));
+        KnotVector::try_new(degree, knots)
+    }
+
+    /// The degree p.
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// The knots.
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// Number of basis functions (control points along this direction).
+    pub fn num_basis(&self) -> usize {
+        self.knots.len() - self.degree - 1
+    }
+
+    /// The parameter domain `[knots[p], knots[n]]`.
+    pub fn domain(&self) -> (f64, f64) {
+        (
+            self.knots[self.degree],
+            self.knots[self.knots.len() - self.degree - 1],
+        )
+    }
+
+    /// `u` clamped into the domain; NaN maps to the domain start.
+    pub fn clamp(&self, u: f64) -> f64 {
+        let (a, b) = self.domain();
+        if u.is_nan() {
+            a
+        } else {
+            u.clamp(a, b)
+        }
+    }
+
+    /// The knot span index i with `knots[i] <= u < knots[i+1]` (A2.1), for `u` clamped into the
+    /// domain; the domain end belongs to the last non-empty span.
+    pub fn find_span(&self, u: f64) -> usize {
+        let u = self.clamp(u);
+        let n = self.num_basis();
+        if u >= self.knots[n] {
+            // Last non-empty span: step back over the clamped end knots.
+            let mut i = n - 1;
+            while i > self.degree && self.knots[i] >= self.knots[n] {
+                i -= 1;
+            }
+            return i;
+        }
+        // First index whose knot exceeds u, minus one.
+        let upper = self.knots[self.degree..=n].partition_point(|&k| k <= u) + self.degree;
+        upper - 1
+    }
+
+    /// The p + 1 non-zero basis functions N_{span-p..=span}(u) and their derivatives up to order
+    /// `d` (A2.3): `out[k][j]` is the k-th derivative of N_{span-p+j}. Derivatives above the
+    /// degree are zero. `u` is clamped into the domain.
+    pub fn basis_ders(&self, span: usize, u: f64, d: usize, out: &mut [[f64; MAX_DEGREE + 1]]) {
+        let p = self.degree;
+        let u = self.clamp(u);
+        let k = &self.knots;
+        let mut ndu = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+        let mut left = [0.0; MAX_DEGREE + 1];
+        let mut right = [0.0; MAX_DEGREE + 1];
+        ndu[0][0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - k[span + 1 - j];
+            right[j] = k[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = ndu[r][j - 1] / ndu[j][r];
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        for row in out.iter_mut().take(d + 1) {
+            row.fill(0.0);
+        }
+        for j in 0..=p {
+            out[0][j] = ndu[j][p];
+        }
+        derivative_rows(p, d.min(p), &ndu, out);
+    }
+
+    /// The p + 1 non-zero basis values at `u` and the index of the first of them.
+    pub fn basis(&self, u: f64) -> (usize, [f64; MAX_DEGREE + 1]) {
+        let span = self.find_span(u);
+        let mut out = [[0.0; MAX_DEGREE + 1]; 1];
+        self.basis_ders(span, u, 0, &mut out);
+        (span - self.degree, out[0])
+    }
+}
+
+/// Rows 1..=d of A2.3: derivatives of the basis functions from the triangular table `ndu`.
+fn derivative_rows(
+    p: usize,
+    d: usize,
+    ndu: &[[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1],
+    out: &mut [[f64; MAX_DEGREE + 1]],
+) {
+    let mut a = [[0.0; MAX_DEGREE + 1]; 2];
+    for r in 0..=p {
+        let (mut s1, mut s2) = (0usize, 1usize);
+        a[0][0] = 1.0;
+        for k in 1..=d {
+            let mut dval = 0.0;
+            let rk = r as isize - k as isize;
+            let pk = p - k;
+            if r >= k {
+                a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                dval = a[s2][0] * ndu[rk as usize][pk];
+            }
+            let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+            let j2 = if (r as isize - 1) <= pk as isize {
+                k - 1
+            } else {
+                p - r
+            };
+            for j in j1..=j2 {
+                let idx = (rk + j as isize) as usize;
+                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                dval += a[s2][j] * ndu[idx][pk];
+            }
+            if r <= pk {
+                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                dval += a[s2][k] * ndu[r][pk];
+            }
+            out[k][r] = dval;
+            std::mem::swap(&mut s1, &mut s2);
+        }
+    }
+    let mut factor = p as f64;
+    for k in 1..=d {
+        for v in out[k].iter_mut().take(p + 1) {
+            *v *= factor;
+        }
+        factor *= (p - k) as f64;
+    }
+}
+
+/// Rejects knots repeated more than p + 1 times.
+fn check_multiplicity(degree: usize, knots: &[f64]) -> Result<(), SplineError> {
+    let mut start = 0;
+    for i in 1..=knots.len() {
+        if i == knots.len() || knots[i] != knots[start] {
+            let multiplicity = i - start;
+            if multiplicity > degree + 1 {
+                let (index, value, limit) = (start, knots[start], degree + 1);
+                return Err(SplineError::KnotMultiplicity {
+                    index,
+                    value,
+                    multiplicity,
+                    limit,
+                });
+            }
+            start = i;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn kv() -> KnotVector {
+        KnotVector::try_new(
+            3,
+            vec![0.0, 0.0, 0.0, 0.0, 0.3, 0.5, 0.5, 0.8, 1.0, 1.0, 1.0, 1.0],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn spans_cover_domain() {
+        let k = kv();
+        assert_eq!(k.num_basis(), 8);
+        assert_eq!(k.find_span(0.0), 3);
+        assert_eq!(k.find_span(0.3), 4);
+        assert_eq!(k.find_span(0.5), 6);
+        assert_eq!(k.find_span(1.0), 7);
+        assert_eq!(k.find_span(7.0), 7);
+        assert_eq!(k.find_span(f64::NAN), 3);
+    }
+
+    #[test]
+    fn rejects_bad_knots() {
+        assert!(matches!(
+            KnotVector::try_new(0, vec![0.0, 1.0]),
+            Err(SplineError::BadDegree { .. })
+        ));
+        assert!(matches!(
+            KnotVector::try_new(2, vec![0.0; 5]),
+            Err(SplineError::TooFewKnots { .. })
+        ));
+        let k = vec![0.0, 0.0, 1.0, 0.5, 1.0, 1.0];
+        assert!(matches!(
+            KnotVector::try_new(2, k),
+            Err(SplineError::DecreasingKnots { index: 3, .. })
+        ));
+        let k = vec![0.0, 0.0, f64::NAN, 1.0];
+        assert!(matches!(
+            KnotVector::try_new(1, k),
+            Err(SplineError::NonFiniteKnot { index: 2 })
+        ));
+        assert!(matches!(
+            KnotVector::try_new(1, vec![0.0; 4]),
+            Err(SplineError::KnotMultiplicity { .. })
+        ));
+        let k = vec![0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0];
+        assert!(matches!(
+            KnotVector::try_new(1, k),
+            Err(SplineError::KnotMultiplicity {
+                multiplicity: 3,
+                ..
+            })
+        ));
+    }
+
+    proptest! {
+        #[test]
+        fn partition_of_unity_and_derivative_sums(u in -0.1f64..1.1) {
+            let k = kv();
+            let span = k.find_span(u);
+            let mut d = [[0.0; MAX_DEGREE + 1]; 4];
+            k.basis_ders(span, u, 3, &mut d);
+            let sums: Vec<f64> = d.iter().map(|row| row.iter().sum()).collect();
+            prop_assert!((sums[0] - 1.0).abs() < 1e-12);
+            for s in &sums[1..] { prop_assert!(s.abs() < 1e-9); }
+            prop_assert!(d[0].iter().all(|&n| n >= -1e-15));
+        }
+
+        #[test]
+        fn derivatives_match_finite_differences(u in 0.01f64..0.99, i in 0usize..8) {
+            let k = kv();
+            let h = 1e-6;
+            let value = |t: f64, order: usize| {
+                let span = k.find_span(t);
+                let mut d = [[0.0; MAX_DEGREE + 1]; 3];
+                k.basis_ders(span, t, 2, &mut d);
+                let first = span - 3;
+                if i >= first && i <= span { d[order][i - first] } else { 0.0 }
+            };
+            // Skip parameters next to a knot, where the derivative jumps.
+            prop_assume!(k.knots().iter().all(|&t| (t - u).abs() > 1e-3));
+            let fd1 = (value(u + h, 0) - value(u - h, 0)) / (2.0 * h);
+            prop_assert!((fd1 - value(u, 1)).abs() < 1e-5, "first derivative {} vs {}", fd1, value(u, 1));
+            let fd2 = (value(u + h, 1) - value(u - h, 1)) / (2.0 * h);
+            prop_assert!((fd2 - value(u, 2)).abs() < 1e-3, "second derivative {} vs {}", fd2, value(u, 2));
+        }
+    }
+}
