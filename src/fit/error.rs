@@ -20,4 +20,17 @@ pub enum FitError {
         /// What is wrong with it.
         reason: String,
     },
+    /// The control mesh cannot be used by the scheme or the refinement (wrong face arity,
+    /// non-manifold or inconsistently oriented edges, ...).
+    #[error("invalid control mesh: {reason}")]
+    ControlMesh {
+        /// What is wrong, with the offending face or vertex.
+        reason: String,
+    },
+    /// A data point has a NaN or infinite coordinate.
+    #[error("data point {index} has a non-finite coordinate")]
+    NonFinitePoint {
+        /// Index of the point in the data.
+        index: usize,
+    },
 }

@@ -3,11 +3,21 @@
 //! iteration (the page animates this) or [`Fitter::run`] to the end, and read statistics and
 //! per-point errors at any time.
 
+mod accel;
+pub mod closest;
 mod error;
+pub mod options;
+pub mod refine;
+pub mod report;
 mod stats;
+pub mod subdiv;
 
+pub use closest::FootPoint;
 pub use error::FitError;
+pub use options::{Acceleration, SubdivFitOptions, Weighting};
+pub use report::FitReport;
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
+pub use subdiv::{ControlSurface, SubdivFitter};
 
 /// What one call of [`Fitter::step`] left the fit in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

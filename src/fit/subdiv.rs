@@ -1,0 +1,495 @@
+//! The subdivision-surface fitter (SPEC §1): foot points by Newton on the limit surface, error
+//! vectors, weighted control-point moves, acceleration with damping, and local refinement.
+
+use super::accel::Accelerator;
+use super::closest::{closest_point, FootPoint, SurfaceIndex};
+use super::options::{SubdivFitOptions, Weighting};
+use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
+use crate::geom::{Aabb, Point3, Vec3};
+use crate::mesh::PolyMesh;
+use crate::subdiv::{LimitSurface, PatchDomain, SurfaceParam};
+use std::collections::HashSet;
+use web_time::Instant;
+
+/// A limit surface the fitter can rebuild from a control mesh, so that refinement (which changes
+/// the connectivity) can continue with the same scheme.
+pub trait ControlSurface: LimitSurface + Sized {
+    /// The scheme's name in reports and on the command line (`loop`, `catmull-clark`, ...).
+    fn scheme_name() -> &'static str;
+
+    /// Turns a mesh into a valid control mesh of the scheme (e.g. quads for Catmull–Clark).
+    /// The default keeps it as it is.
+    fn prepare_control(mesh: PolyMesh) -> Result<PolyMesh, FitError> {
+        Ok(mesh)
+    }
+
+    /// The limit surface of `control` (a mesh that [`ControlSurface::prepare_control`] accepts).
+    fn from_control_mesh(control: &PolyMesh) -> Result<Self, FitError>;
+
+    /// The face of the control mesh the surface was built from that `patch` belongs to.
+    fn patch_face(&self, patch: u32) -> usize;
+
+    /// Splits the `marked` faces of `control` (one flag per face) and what conformity needs
+    /// around them, placing new points so that the limit surface changes as little as possible.
+    fn refine_control(control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError>;
+
+    /// Local remeshing after a refinement (edge flips for triangle schemes). Returns the number
+    /// of changes; the default makes none.
+    fn remesh_control(control: &mut PolyMesh) -> Result<usize, FitError> {
+        let _ = control;
+        Ok(0)
+    }
+}
+
+/// Fits the limit surface of a subdivision scheme `S` to data points by geometric iteration.
+///
+/// Build it with [`SubdivFitter::try_new`], then drive it through [`Fitter`]. Everything before
+/// the first iteration (surface set-up, spatial index, first foot points) is the precompute
+/// phase, timed by [`SubdivFitter::precompute_seconds`].
+pub struct SubdivFitter<S: ControlSurface> {
+    data: Vec<Point3>,
+    diagonal: f64,
+    faces: PolyMesh,
+    surface: S,
+    feet: Vec<FootPoint>,
+    signed: Vec<f64>,
+    stats: ErrorStats,
+    history: Vec<IterationRecord>,
+    options: SubdivFitOptions,
+    initial_control: usize,
+    since_refine: usize,
+    accel: Accelerator,
+    index: SurfaceIndex,
+    status: FitStatus,
+    precompute_s: f64,
+    scratch: Vec<(u32, f64)>,
+}
+
+impl<S: ControlSurface> SubdivFitter<S> {
+    /// A fitter of `data_points` starting from `initial_control` (any mesh the scheme accepts;
+    /// see [`ControlSurface::prepare_control`]). Data points need no connectivity.
+    pub fn try_new(
+        data_points: &[Point3],
+        initial_control: PolyMesh,
+        options: SubdivFitOptions,
+    ) -> Result<Self, FitError> {
+        let start = Instant::now();
+        options.validate()?;
+        if let Some(index) = data_points.iter().position(|p| !p.is_finite()) {
+            return Err(FitError::NonFinitePoint { index });
+        }
+        let bbox = Aabb::from_points(data_points).ok_or(FitError::TooFewPoints {
+            found: 0,
+            needed: 1,
+        })?;
+        let control = S::prepare_control(initial_control)?;
+        if control.num_faces() == 0 {
+            return Err(FitError::ControlMesh {
+                reason: "the control mesh has no faces".into(),
+            });
+        }
+        let surface = S::from_control_mesh(&control)?;
+        let index = SurfaceIndex::build(&surface, options.index_resolution);
+        let diagonal = bbox.diagonal();
+        let mut fitter = SubdivFitter {
+            data: data_points.to_vec(),
+            diagonal: if diagonal > 0.0 { diagonal } else { 1.0 },
+            initial_control: control.num_vertices(),
+            faces: control,
+            surface,
+            feet: Vec::new(),
+            signed: Vec::new(),
+            stats: ErrorStats::default(),
+            history: Vec::new(),
+            options,
+            since_refine: 0,
+            accel: Accelerator::new(options.acceleration),
+            index,
+            status: FitStatus::Running,
+            precompute_s: 0.0,
+            scratch: Vec::new(),
+        };
+        fitter.search_all_feet()?;
+        fitter.precompute_s = start.elapsed().as_secs_f64();
+        Ok(fitter)
+    }
+
+    /// Seconds spent in [`SubdivFitter::try_new`].
+    pub fn precompute_seconds(&self) -> f64 {
+        self.precompute_s
+    }
+
+    /// The data points, in input order.
+    pub fn data(&self) -> &[Point3] {
+        &self.data
+    }
+
+    /// Diagonal of the data's bounding box: what the `_pct` figures are relative to.
+    pub fn diagonal(&self) -> f64 {
+        self.diagonal
+    }
+
+    /// The current limit surface.
+    pub fn surface(&self) -> &S {
+        &self.surface
+    }
+
+    /// The current control mesh (connectivity and control points).
+    pub fn control_mesh(&self) -> PolyMesh {
+        let faces: Vec<&[u32]> = self.faces.faces().collect();
+        PolyMesh::try_new(self.surface.control_points().to_vec(), faces)
+            .unwrap_or_else(|_| self.faces.clone())
+    }
+
+    /// Number of control points now.
+    pub fn num_control_points(&self) -> usize {
+        self.surface.control_points().len()
+    }
+
+    /// Number of control points the fit started with.
+    pub fn initial_control_points(&self) -> usize {
+        self.initial_control
+    }
+
+    /// Current foot point of every data point, in data order.
+    pub fn foot_points(&self) -> &[FootPoint] {
+        &self.feet
+    }
+
+    /// Error vector e_i = p_i − S(t_i) of every data point.
+    pub fn error_vectors(&self) -> Vec<Vec3> {
+        self.data
+            .iter()
+            .zip(&self.feet)
+            .map(|(p, f)| *p - f.point)
+            .collect()
+    }
+
+    /// The options in force.
+    pub fn options(&self) -> &SubdivFitOptions {
+        &self.options
+    }
+
+    /// Where the fit stands.
+    pub fn status(&self) -> FitStatus {
+        self.status
+    }
+
+    /// The limit surface tessellated with `resolution` segments per patch edge, for display and
+    /// export (patches are not welded to each other).
+    pub fn limit_mesh(&self, resolution: usize) -> PolyMesh {
+        tessellate(&self.surface, resolution.clamp(1, 64))
+    }
+
+    /// The control-point budget: the option, or half the number of data points.
+    fn budget(&self) -> usize {
+        self.options
+            .max_control
+            .unwrap_or(self.data.len() / 2)
+            .max(self.initial_control)
+    }
+
+    /// Global search: every foot point from the spatial index, then Newton.
+    fn search_all_feet(&mut self) -> Result<(), FitError> {
+        let opts = self.options.newton;
+        let mut feet = Vec::with_capacity(self.data.len());
+        for (i, &p) in self.data.iter().enumerate() {
+            let start = self.index.nearest(p).ok_or_else(|| FitError::ControlMesh {
+                reason: format!("the limit surface has no finite point near data point {i}"),
+            })?;
+            feet.push(closest_point(&self.surface, p, start, &opts, self.diagonal));
+        }
+        self.feet = feet;
+        self.update_errors();
+        Ok(())
+    }
+
+    /// Warm-started Newton from the previous foot points; a point whose result is suspect (not
+    /// converged, or much farther than before) is searched again from the spatial index, and
+    /// the better of the two results is kept.
+    fn update_feet(&mut self, previous: &[FootPoint]) {
+        let opts = self.options.newton;
+        let slack = 1e-3 * self.diagonal;
+        for (i, &p) in self.data.iter().enumerate() {
+            let prev = previous[i];
+            let mut foot = closest_point(&self.surface, p, prev.param, &opts, self.diagonal);
+            let grew = foot.dist_sq.sqrt() > 2.0 * prev.dist_sq.sqrt() + slack;
+            if !foot.converged || grew {
+                if let Some(start) = self.index.nearest(p) {
+                    let other = closest_point(&self.surface, p, start, &opts, self.diagonal);
+                    if other.dist_sq < foot.dist_sq {
+                        foot = other;
+                    }
+                }
+            }
+            self.feet[i] = foot;
+        }
+        self.update_errors();
+    }
+
+    /// Signed distances and statistics from the current foot points.
+    fn update_errors(&mut self) {
+        self.signed.clear();
+        for (p, f) in self.data.iter().zip(&self.feet) {
+            let e = self.surface.eval(f.param);
+            let d = f.dist_sq.sqrt();
+            let side = (*p - f.point).dot(e.du.cross(e.dv));
+            let s = if side < 0.0 { -d } else { d };
+            self.signed.push(if s.is_finite() { s } else { f64::MAX });
+        }
+        self.stats = ErrorStats::from_distances(&self.signed, self.diagonal);
+    }
+
+    /// The move of every control point: the normalised weighted sum of the error vectors
+    /// (patent or basis weights).
+    fn moves(&mut self) -> Vec<Vec3> {
+        let n = self.num_control_points();
+        let mut sum = vec![Vec3::ZERO; n];
+        let mut weight = vec![0.0; n];
+        for (p, f) in self.data.iter().zip(&self.feet) {
+            let e = *p - f.point;
+            self.scratch.clear();
+            match self.options.weighting {
+                Weighting::Patent => self.surface.corner_weights(f.param, &mut self.scratch),
+                Weighting::Basis => self.surface.stencil(f.param, &mut self.scratch),
+            }
+            for &(j, w) in &self.scratch {
+                if let (Some(s), Some(t)) = (sum.get_mut(j as usize), weight.get_mut(j as usize)) {
+                    *s += e * w;
+                    *t += w;
+                }
+            }
+        }
+        sum.iter()
+            .zip(&weight)
+            .map(|(s, &w)| if w > 1e-12 { *s / w } else { Vec3::ZERO })
+            .collect()
+    }
+
+    /// One move of the control points with damping: a move that raises E_rms is halved (twice at
+    /// most) and otherwise undone. Returns whether a move was kept.
+    fn move_control_points(&mut self) -> bool {
+        let old_points = self.surface.control_points().to_vec();
+        let old_feet = self.feet.clone();
+        let (old_signed, old_stats) = (self.signed.clone(), self.stats);
+        let d = self.moves();
+        let proposal = self.accel.propose(&old_points, &d);
+        self.surface.set_control_points(&proposal);
+        self.update_feet(&old_feet);
+        if !self.options.damping || self.stats.e_rms <= old_stats.e_rms * (1.0 + 1e-12) {
+            return true;
+        }
+        self.accel.reset();
+        for t in [0.5, 0.25] {
+            let damped: Vec<Point3> = old_points
+                .iter()
+                .zip(&d)
+                .map(|(p, v)| *p + *v * t)
+                .collect();
+            self.surface.set_control_points(&damped);
+            self.update_feet(&old_feet);
+            if self.stats.e_rms <= old_stats.e_rms {
+                return true;
+            }
+        }
+        self.surface.set_control_points(&old_points);
+        self.feet = old_feet;
+        self.signed = old_signed;
+        self.stats = old_stats;
+        false
+    }
+
+    /// Faces to split: those holding a point beyond the E_max tolerance, or whose mean distance
+    /// exceeds the E_avg (or E_rms) tolerance; worst first, as many as the budget allows.
+    fn faces_to_split(&self) -> Vec<usize> {
+        let nf = self.faces.num_faces();
+        let (mut max, mut sum, mut sum_sq, mut count) = (
+            vec![0.0f64; nf],
+            vec![0.0; nf],
+            vec![0.0; nf],
+            vec![0usize; nf],
+        );
+        for (f, d) in self.feet.iter().zip(&self.signed) {
+            let face = self.surface.patch_face(f.param.patch);
+            if face < nf {
+                max[face] = max[face].max(d.abs());
+                sum[face] += d.abs();
+                sum_sq[face] += d * d;
+                count[face] += 1;
+            }
+        }
+        let t = self.options.tolerances;
+        let abs = |pct: Option<f64>| pct.map(|v| v / 100.0 * self.diagonal);
+        let (tmax, tavg, trms) = (abs(t.max_pct), abs(t.avg_pct), abs(t.rms_pct));
+        let ratio = |value: f64, tol: Option<f64>| tol.map_or(0.0, |t| value / t.max(1e-300));
+        let mut scored: Vec<(f64, usize)> = (0..nf)
+            .filter(|&f| count[f] > 0)
+            .map(|f| {
+                let n = count[f] as f64;
+                let s = ratio(max[f], tmax)
+                    .max(ratio(sum[f] / n, tavg))
+                    .max(ratio((sum_sq[f] / n).sqrt(), trms));
+                (s, f)
+            })
+            .filter(|(s, _)| *s > 1.0)
+            .collect();
+        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let room = self.budget().saturating_sub(self.num_control_points());
+        let mut edges = HashSet::new();
+        let mut chosen = Vec::new();
+        for (_, f) in scored {
+            let face = self.faces.face(f);
+            for k in 0..face.len() {
+                let (a, b) = (face[k], face[(k + 1) % face.len()]);
+                edges.insert((a.min(b), a.max(b)));
+            }
+            if edges.len() > room {
+                break;
+            }
+            chosen.push(f);
+        }
+        chosen
+    }
+
+    /// Splits the worst faces within the budget and rebuilds the surface. Returns whether the
+    /// control mesh changed.
+    fn refine(&mut self) -> Result<bool, FitError> {
+        let mut chosen = self.faces_to_split();
+        let control = self.control_mesh();
+        while !chosen.is_empty() {
+            let mut marked = vec![false; control.num_faces()];
+            for &f in &chosen {
+                marked[f] = true;
+            }
+            let mut refined = S::refine_control(&control, &marked)?;
+            if refined.num_vertices() <= self.budget() {
+                if self.options.remesh {
+                    S::remesh_control(&mut refined)?;
+                }
+                self.surface = S::from_control_mesh(&refined)?;
+                self.faces = refined;
+                self.index = SurfaceIndex::build(&self.surface, self.options.index_resolution);
+                self.accel.reset();
+                self.search_all_feet()?;
+                return Ok(true);
+            }
+            chosen.truncate(chosen.len() / 2);
+        }
+        Ok(false)
+    }
+
+    fn due_for_refinement(&self, improvement: f64) -> bool {
+        self.options.refine
+            && self.num_control_points() < self.budget()
+            && (self.since_refine >= self.options.refine_interval
+                || (self.since_refine >= 2 && improvement < self.options.stall_ratio))
+    }
+}
+
+impl<S: ControlSurface> Fitter for SubdivFitter<S> {
+    fn step(&mut self) -> Result<FitStatus, FitError> {
+        if self.status != FitStatus::Running {
+            return Ok(self.status);
+        }
+        if self.options.tolerances.met_by(&self.stats) {
+            self.status = FitStatus::Converged;
+            return Ok(self.status);
+        }
+        let start = Instant::now();
+        let before = self.stats.e_rms;
+        let moved = self.move_control_points();
+        self.since_refine += 1;
+        let improvement = if before > 0.0 && moved {
+            (before - self.stats.e_rms) / before
+        } else {
+            0.0
+        };
+        let mut refined = false;
+        if !self.options.tolerances.met_by(&self.stats) && self.due_for_refinement(improvement) {
+            refined = self.refine()?;
+            if refined {
+                self.since_refine = 0;
+            }
+        }
+        let iter = self.history.len() + 1;
+        self.history.push(IterationRecord {
+            iter,
+            control_points: self.num_control_points(),
+            e_avg_pct: self.stats.e_avg_pct,
+            e_max_pct: self.stats.e_max_pct,
+            e_rms_pct: self.stats.e_rms_pct,
+            ms: start.elapsed().as_secs_f64() * 1e3,
+            refined,
+        });
+        self.status = if self.options.tolerances.met_by(&self.stats) {
+            FitStatus::Converged
+        } else if iter >= self.options.max_iter {
+            FitStatus::MaxIterations
+        } else {
+            FitStatus::Running
+        };
+        Ok(self.status)
+    }
+
+    fn history(&self) -> &[IterationRecord] {
+        &self.history
+    }
+
+    fn point_errors(&self) -> &[f64] {
+        &self.signed
+    }
+
+    fn stats(&self) -> ErrorStats {
+        self.stats
+    }
+}
+
+/// Tessellates every patch with `r` segments per edge.
+fn tessellate<S: LimitSurface + ?Sized>(surface: &S, r: usize) -> PolyMesh {
+    let mut points = Vec::new();
+    let mut tris: Vec<[u32; 3]> = Vec::new();
+    let h = 1.0 / r as f64;
+    for patch in 0..surface.num_patches() as u32 {
+        let base = points.len() as u32;
+        let at = |u: f64, v: f64| surface.eval(SurfaceParam { patch, u, v }).point;
+        match surface.domain() {
+            PatchDomain::Square => {
+                for i in 0..=r {
+                    for j in 0..=r {
+                        points.push(at(i as f64 * h, j as f64 * h));
+                    }
+                }
+                let id = |i: usize, j: usize| base + (i * (r + 1) + j) as u32;
+                for i in 0..r {
+                    for j in 0..r {
+                        tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                        tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+                    }
+                }
+            }
+            PatchDomain::Triangle => {
+                let mut row_start = Vec::with_capacity(r + 1);
+                for i in 0..=r {
+                    row_start.push(points.len() as u32 - base);
+                    for j in 0..=r - i {
+                        points.push(at(i as f64 * h, j as f64 * h));
+                    }
+                }
+                let id = |i: usize, j: usize| base + row_start[i] + j as u32;
+                for i in 0..r {
+                    for j in 0..r - i {
+                        tris.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
+                        if j + 1 < r - i {
+                            tris.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let points = points
+        .into_iter()
+        .map(|p| if p.is_finite() { p } else { Point3::ZERO })
+        .collect();
+    PolyMesh::try_new(points, tris).unwrap_or_default()
+}

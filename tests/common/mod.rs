@@ -1,0 +1,127 @@
+//! Shared helpers of the integration tests: the data directory, small meshes, and a
+//! piecewise-linear `LimitSurface` the fitting engine can be checked against.
+#![allow(dead_code)]
+
+pub mod linear;
+
+use geofit::geom::Point3;
+use geofit::mesh::PolyMesh;
+use std::path::PathBuf;
+
+/// `$GEOFIT_DATA`, else `<repo>/../shared/data`, else `/work/shared/data`.
+pub fn data_dir() -> PathBuf {
+    if let Ok(dir) = std::env::var("GEOFIT_DATA") {
+        return PathBuf::from(dir);
+    }
+    let beside = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    if beside.exists() {
+        return beside;
+    }
+    PathBuf::from("/work/shared/data")
+}
+
+/// A deterministic pseudo-random generator (SplitMix64) so tests need no seed handling.
+pub struct Rng(pub u64);
+
+impl Rng {
+    /// Uniform in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in [-1, 1)³.
+    pub fn vec(&mut self) -> Point3 {
+        Point3::new(
+            2.0 * self.next_f64() - 1.0,
+            2.0 * self.next_f64() - 1.0,
+            2.0 * self.next_f64() - 1.0,
+        )
+    }
+}
+
+/// An octahedron subdivided `levels` times (midpoints pushed onto the unit sphere): a closed,
+/// consistently oriented triangle mesh with valence-4 and valence-6 vertices.
+pub fn sphere_mesh(levels: usize) -> PolyMesh {
+    let mut pts = vec![
+        Point3::X,
+        Point3::NEG_X,
+        Point3::Y,
+        Point3::NEG_Y,
+        Point3::Z,
+        Point3::NEG_Z,
+    ];
+    let mut tris: Vec<[u32; 3]> = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut next = Vec::new();
+        let mut m = |a: u32, b: u32, pts: &mut Vec<Point3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                pts.push(((pts[a as usize] + pts[b as usize]) * 0.5).normalize());
+                pts.len() as u32 - 1
+            })
+        };
+        for [a, b, c] in tris {
+            let (ab, bc, ca) = (m(a, b, &mut pts), m(b, c, &mut pts), m(c, a, &mut pts));
+            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    PolyMesh::try_new(pts, tris).expect("valid sphere")
+}
+
+/// An open n × n grid of triangles over [0, 1]² with a bump of `height`: a surface with a
+/// boundary.
+pub fn bump_grid(n: usize, height: f64) -> PolyMesh {
+    let mut pts = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            let z = height * (-8.0 * ((x - 0.5).powi(2) + (y - 0.4).powi(2))).exp();
+            pts.push(Point3::new(x, y, z));
+        }
+    }
+    let id = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    PolyMesh::try_new(pts, tris).expect("valid grid")
+}
+
+/// The same mesh with every point moved by up to `amount` in each coordinate.
+pub fn perturbed(mesh: &PolyMesh, amount: f64, rng: &mut Rng) -> PolyMesh {
+    let pts = mesh
+        .positions()
+        .iter()
+        .map(|p| *p + rng.vec() * amount)
+        .collect();
+    let faces: Vec<&[u32]> = mesh.faces().collect();
+    PolyMesh::try_new(pts, faces).expect("same connectivity")
+}
+
+/// The same mesh with every point moved along z by up to `amount`.
+pub fn perturbed_z(mesh: &PolyMesh, amount: f64, rng: &mut Rng) -> PolyMesh {
+    let pts = mesh
+        .positions()
+        .iter()
+        .map(|p| *p + Point3::Z * (rng.next_f64() * 2.0 - 1.0) * amount)
+        .collect();
+    let faces: Vec<&[u32]> = mesh.faces().collect();
+    PolyMesh::try_new(pts, faces).expect("same connectivity")
+}
