@@ -125,3 +125,15 @@ pub fn perturbed_z(mesh: &PolyMesh, amount: f64, rng: &mut Rng) -> PolyMesh {
     let faces: Vec<&[u32]> = mesh.faces().collect();
     PolyMesh::try_new(pts, faces).expect("same connectivity")
 }
+
+/// A file in the shared scan directory.
+pub fn data_file(name: &str) -> PathBuf {
+    data_dir().join(name)
+}
+
+/// A file in the repository's own `tests/data` (small, often deliberately malformed samples).
+pub fn test_file(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}

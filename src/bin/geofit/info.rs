@@ -7,30 +7,40 @@ use std::path::PathBuf;
 pub struct Args {
     /// Point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS).
     file: PathBuf,
-    /// Print one JSON object instead of text.
+    /// Print one JSON object on one line instead of indented JSON.
     #[arg(long)]
     json: bool,
 }
 
+/// Reads the file and prints its format, counts and bounding box. `triangles` counts the mesh
+/// after triangulating polygons and strips; a range scan's grid is reported as
+/// `range_grid: [cols, rows]` and not counted as triangles.
 pub fn run(args: Args) -> Result<(), String> {
     let loaded =
         geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
     let mesh = &loaded.mesh;
     let bbox = mesh.bbox();
-    let report = serde_json::json!({
+    let mut report = serde_json::json!({
         "format": loaded.format,
         "points": mesh.num_vertices(),
         "triangles": mesh.num_triangles(),
         "bbox_min": bbox.map(|b| b.min.to_array()),
         "bbox_max": bbox.map(|b| b.max.to_array()),
     });
-    if args.json {
-        println!("{report}");
-    } else {
-        println!(
-            "{}",
-            serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-        );
+    if let Some(grid) = &loaded.range_grid {
+        report["range_grid"] = serde_json::json!([grid.cols(), grid.rows()]);
     }
+    if !loaded.polylines.is_empty() {
+        report["polylines"] = loaded.polylines.len().into();
+    }
+    if loaded.dimension == 2 {
+        report["dimension"] = 2.into();
+    }
+    let text = if args.json {
+        report.to_string()
+    } else {
+        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
+    };
+    println!("{text}");
     Ok(())
 }

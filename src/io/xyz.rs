@@ -1,0 +1,113 @@
+//! Plain point text: XYZ, CSV and PTS. One point per line, fields separated by whitespace,
+//! commas or semicolons; leading non-numeric lines are a header; `#` and `//` lines are
+//! comments; a line holding one integer is a PTS point count and is skipped; columns beyond
+//! x, y, z (intensity, colour, normals) are ignored. Files with two numeric columns are 2D
+//! points (z = 0).
+
+use super::text::{coordinate, lines, parse_f64, parse_i64};
+use super::{Format, LoadedFile, Location, ReadError};
+use crate::geom::Point3;
+use crate::mesh::PolyMesh;
+
+const XYZ: Format = Format::Xyz;
+
+/// The fields of a line, without surrounding quotes.
+fn fields(line: &[u8]) -> impl Iterator<Item = &[u8]> {
+    line.split(|&b| b.is_ascii_whitespace() || b == b',' || b == b';')
+        .filter(|f| !f.is_empty())
+        .map(|f| f.strip_prefix(b"\"").unwrap_or(f))
+        .map(|f| f.strip_suffix(b"\"").unwrap_or(f))
+}
+
+/// How many leading fields (at most three) are numbers: 2 or 3 for a point line.
+pub fn numeric_fields(line: &[u8]) -> usize {
+    fields(line)
+        .take(3)
+        .take_while(|f| parse_f64(f).is_some())
+        .count()
+}
+
+fn is_comment(line: &[u8]) -> bool {
+    let t = line.trim_ascii_start();
+    t.starts_with(b"#") || t.starts_with(b"//")
+}
+
+fn is_count_line(line: &[u8]) -> bool {
+    let mut f = fields(line);
+    matches!((f.next(), f.next()), (Some(n), None) if parse_i64(n).is_some())
+}
+
+pub fn read(bytes: &[u8]) -> Result<LoadedFile, ReadError> {
+    let mut positions = Vec::new();
+    let mut columns = 0;
+    for (line_no, line) in lines(bytes) {
+        if is_comment(line) || is_count_line(line) || fields(line).next().is_none() {
+            continue;
+        }
+        if columns == 0 {
+            columns = numeric_fields(line);
+            if columns < 2 {
+                columns = 0; // still in the header
+                continue;
+            }
+        }
+        positions.push(point(line, line_no, columns)?);
+    }
+    let mesh = PolyMesh::from_points(positions)?;
+    Ok(LoadedFile {
+        dimension: if columns == 2 { 2 } else { 3 },
+        ..LoadedFile::from_mesh(XYZ, mesh)
+    })
+}
+
+fn point(line: &[u8], line_no: usize, columns: usize) -> Result<Point3, ReadError> {
+    let at = Location::Line(line_no);
+    let mut xyz = [0.0; 3];
+    let mut f = fields(line);
+    for (k, c) in xyz.iter_mut().take(columns).enumerate() {
+        let t = f.next().ok_or_else(|| ReadError::Syntax {
+            format: XYZ,
+            at,
+            message: format!("expected {columns} numbers, found {k}"),
+        })?;
+        *c = coordinate(t, XYZ, at)?;
+    }
+    Ok(Point3::from_array(xyz))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_with_header_and_extra_columns() {
+        let f = read(b"x;y;z;i\n# c\n1;2;3;9\n\"4\",\"5\",\"6\"\n").unwrap();
+        assert_eq!(f.mesh.positions()[1], Point3::new(4.0, 5.0, 6.0));
+        assert_eq!(f.dimension, 3);
+    }
+
+    #[test]
+    fn pts_count_lines_and_2d_files() {
+        let f = read(b"2\n1 2 3 10 255 0 0\n4 5 6 10 0 255 0\n").unwrap();
+        assert_eq!(f.mesh.num_vertices(), 2);
+        let f = read(b"0.5 1\n2 3\n").unwrap();
+        assert_eq!(f.dimension, 2);
+        assert_eq!(f.mesh.positions()[1], Point3::new(2.0, 3.0, 0.0));
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let e = read(b"x y z\n1 2 3\n4 five 6\n").unwrap_err();
+        assert_eq!(e.to_string(), "XYZ line 3: expected a number, found 'five'");
+        let e = read(b"1 2 3\n4\n5 6\n").unwrap_err();
+        assert_eq!(e.to_string(), "XYZ line 3: expected 3 numbers, found 2");
+        let e = read(b"1 2 3\n1 2 NaN\n").unwrap_err();
+        assert!(matches!(
+            e,
+            ReadError::NonFinite {
+                at: Location::Line(2),
+                ..
+            }
+        ));
+    }
+}
