@@ -2,7 +2,11 @@
 //! subdivision and fitting work on.
 
 mod error;
+mod halfedge;
 mod poly;
+mod validate;
 
 pub use error::MeshError;
+pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
+pub use validate::TopologyError;

@@ -6,9 +6,71 @@
 //! points that influence it (the stencil), and a way to walk across patch edges.
 
 use crate::geom::{Point3, Vec3};
+use crate::mesh::{ControlMesh, MeshError, PolyMesh, TopologyError};
+
+mod basis;
+mod doo_sabin;
+mod patch;
+mod refine;
+mod surface;
+mod topo;
+mod walk;
+
+pub use refine::{quadrangulate, refine, refine_levels};
+pub use surface::{SubdivSurface, Tessellation};
+
+/// Why a subdivision surface could not be built or refined.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum SubdivError {
+    /// The polygon data is invalid.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The connectivity is not an oriented manifold (with boundary).
+    #[error(transparent)]
+    Topology(#[from] TopologyError),
+    /// The mesh has no faces.
+    #[error("the control mesh has no faces")]
+    NoFaces,
+    /// A face has the wrong number of corners for the scheme.
+    #[error("face {face} has {len} corners; {scheme:?} needs {}", if *scheme == Scheme::Loop { "triangles" } else { "quads (convert with subdiv::quadrangulate)" })]
+    WrongFaceSize {
+        /// The offending face.
+        face: usize,
+        /// Its corner count.
+        len: usize,
+        /// The scheme asked for.
+        scheme: Scheme,
+    },
+    /// A patch's neighbourhood has more control points than evaluation supports (very high
+    /// valence).
+    #[error("patch {patch} depends on {points} control points; at most {max} are supported (reduce vertex valence)")]
+    NeighbourhoodTooLarge {
+        /// The patch.
+        patch: usize,
+        /// Control points it depends on.
+        points: usize,
+        /// The limit.
+        max: usize,
+    },
+    /// The scheme's rules could not be applied around a patch (internal consistency check).
+    #[error(
+        "patch {patch} cannot be evaluated: its neighbourhood does not determine the limit surface"
+    )]
+    Unevaluable {
+        /// The patch.
+        patch: usize,
+    },
+    /// The operation is not available for this scheme.
+    #[error("{what} is not implemented")]
+    Unsupported {
+        /// What was asked for.
+        what: &'static str,
+    },
+}
 
 /// A subdivision scheme.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Scheme {
     /// Loop: triangle meshes, quartic box-spline limit.
     Loop,
@@ -81,3 +143,83 @@ pub trait LimitSurface {
     /// them, crossing edges as needed, and clamps onto the domain at open boundaries.
     fn relocate(&self, patch: u32, u: f64, v: f64) -> SurfaceParam;
 }
+
+/// The limit surface of `mesh` under `scheme`, ready for fitting. Loop needs a triangle mesh;
+/// for Catmull–Clark a mesh that is not all quads is first converted by one Catmull–Clark step
+/// ([`quadrangulate`]), so its control points are then those of the converted mesh (read them
+/// with [`LimitSurface::control_points`]).
+pub fn build(scheme: Scheme, mesh: &PolyMesh) -> Result<Box<dyn LimitSurface>, SubdivError> {
+    let control = ControlMesh::try_new(mesh)?;
+    let control = if scheme == Scheme::CatmullClark && !control.is_quad_mesh() {
+        quadrangulate(&control)?
+    } else {
+        control
+    };
+    Ok(Box::new(SubdivSurface::try_new(scheme, control)?))
+}
+
+macro_rules! scheme_surface {
+    ($(#[$doc:meta])* $name:ident, $scheme:expr) => {
+        $(#[$doc])*
+        pub struct $name(SubdivSurface);
+
+        impl $name {
+            /// Builds the surface from a polygon mesh, checking its topology.
+            pub fn try_new(mesh: &PolyMesh) -> Result<$name, SubdivError> {
+                $name::from_control_mesh(ControlMesh::try_new(mesh)?)
+            }
+
+            /// Builds the surface from a control mesh (keeps its crease tags).
+            pub fn from_control_mesh(mesh: ControlMesh) -> Result<$name, SubdivError> {
+                Ok($name(SubdivSurface::try_new($scheme, mesh)?))
+            }
+        }
+
+        impl std::ops::Deref for $name {
+            type Target = SubdivSurface;
+            fn deref(&self) -> &SubdivSurface {
+                &self.0
+            }
+        }
+
+        impl LimitSurface for $name {
+            fn domain(&self) -> PatchDomain {
+                self.0.domain()
+            }
+            fn num_patches(&self) -> usize {
+                self.0.num_patches()
+            }
+            fn control_points(&self) -> &[Point3] {
+                self.0.control_points()
+            }
+            fn set_control_points(&mut self, points: &[Point3]) {
+                self.0.set_control_points(points)
+            }
+            fn eval(&self, at: SurfaceParam) -> LimitEval {
+                self.0.eval(at)
+            }
+            fn stencil(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>) {
+                self.0.stencil(at, out)
+            }
+            fn corner_weights(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>) {
+                self.0.corner_weights(at, out)
+            }
+            fn relocate(&self, patch: u32, u: f64, v: f64) -> SurfaceParam {
+                self.0.relocate(patch, u, v)
+            }
+        }
+    };
+}
+
+scheme_surface!(
+    /// Loop limit surface of a triangle control mesh: a quartic box spline on regular patches,
+    /// exact local subdivision near extraordinary vertices, boundaries and creases.
+    LoopSurface,
+    Scheme::Loop
+);
+scheme_surface!(
+    /// Catmull–Clark limit surface of a quad control mesh: bicubic B-spline patches (with
+    /// phantom points at straight boundaries and creases), exact local subdivision elsewhere.
+    CatmullClarkSurface,
+    Scheme::CatmullClark
+);

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod linear;
+pub mod meshes;
 
 use geofit::geom::Point3;
 use geofit::mesh::PolyMesh;

@@ -1,0 +1,710 @@
+//! Exact limit evaluation by local subdivision over a shared graph of patch types.
+//!
+//! A patch is a control face with its neighbourhood (every face touching one of its corners).
+//! If the neighbourhood is regular, the limit is a closed-form spline over it (box spline or
+//! bicubic B-spline, with phantom points reflected across boundaries and creases where that is
+//! exact). Otherwise the neighbourhood is subdivided once with the scheme's own rules and the
+//! parameter moves into one of the child patches, until a regular child is reached; the limit
+//! at an extraordinary vertex itself comes from the scheme's limit mask.
+//!
+//! The subdivision matrices depend only on the neighbourhood's connectivity, so neighbourhoods
+//! are put in a canonical order and interned: all patches and sub-patches of the same shape
+//! share one node, and the sub-patch at an extraordinary vertex maps to itself after the first
+//! step (a self-loop in the graph), as in Stam's eigen-analysis but without eigenvectors.
+
+use super::basis::{bicubic, bicubic_lattice, loop_box, LOOP_LATTICE};
+use super::topo::{key, EdgeTag, Stencil, Topo, NO};
+use super::{LimitEval, Scheme, SubdivError};
+use crate::geom::{Point3, Vec3};
+use std::collections::HashMap;
+
+/// Most control points one neighbourhood may have (sizes the stack buffers of evaluation).
+pub(crate) const MAX_LOCAL: usize = 96;
+/// Subdivision depth after which a parameter counts as being at the extraordinary vertex
+/// (sub-patch size 2⁻⁴⁰ of the patch).
+const MAX_DEPTH: usize = 40;
+/// Extra levels allowed after moving to the sub-patch centre at [`MAX_DEPTH`].
+const EXTRA_DEPTH: usize = 24;
+
+/// Affine map from a parent patch's parameters into a child's: `child = m · (p − origin)`.
+#[derive(Clone, Copy, Debug)]
+struct ChildMap {
+    origin: [f64; 2],
+    m: [[f64; 2]; 2],
+}
+
+impl ChildMap {
+    fn new(q0: [f64; 2], q1: [f64; 2], q2: [f64; 2]) -> ChildMap {
+        let a = [
+            [q1[0] - q0[0], q2[0] - q0[0]],
+            [q1[1] - q0[1], q2[1] - q0[1]],
+        ];
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        let m = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
+        ChildMap { origin: q0, m }
+    }
+
+    fn apply(&self, u: f64, v: f64) -> (f64, f64) {
+        let (du, dv) = (u - self.origin[0], v - self.origin[1]);
+        (
+            self.m[0][0] * du + self.m[0][1] * dv,
+            self.m[1][0] * du + self.m[1][1] * dv,
+        )
+    }
+}
+
+struct Child {
+    node: u32,
+    k: usize,
+    /// `k × parent k`, row-major: child points from parent points.
+    mat: Vec<f64>,
+    map: ChildMap,
+}
+
+enum Node {
+    /// Placeholder while the node is being built.
+    Pending,
+    /// Closed-form patch: `gather` (`nb × k`) makes the spline's control points.
+    Regular { k: usize, gather: Vec<f64> },
+    /// Subdivide: one child per sub-patch, and the limit masks of the corners.
+    Split {
+        k: usize,
+        children: Vec<Child>,
+        corner_masks: Vec<Vec<(u16, f64)>>,
+    },
+}
+
+/// The interned patch shapes of one surface.
+pub(crate) struct Graph {
+    scheme: Scheme,
+    nodes: Vec<Node>,
+    index: HashMap<Vec<u32>, u32>,
+    pending: Vec<(u32, Topo)>,
+}
+
+/// A canonical neighbourhood of one face: local topology and where each local point came from.
+pub(crate) struct Neighbourhood {
+    pub topo: Topo,
+    pub source: Vec<u32>,
+    key: Vec<u32>,
+}
+
+/// Gathers the faces around every corner of `f` in a canonical order: corners first, then the
+/// fans of the corners in turn (counter-clockwise from `f`, then clockwise).
+pub(crate) fn neighbourhood(src: &Topo, f: u32) -> Neighbourhood {
+    let mut source: Vec<u32> = src.face(f).to_vec();
+    let mut local: HashMap<u32, u32> = source
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (v, i as u32))
+        .collect();
+    let mut faces = vec![f];
+    let mut fan = Vec::new();
+    for &c in src.face(f) {
+        fan.clear();
+        src.fan(c, f, false, &mut fan);
+        for &g in &fan {
+            if faces.contains(&g) {
+                continue;
+            }
+            faces.push(g);
+            let gv = src.face(g);
+            let start = gv.iter().position(|&x| x == c).unwrap_or(0);
+            for i in 0..gv.len() {
+                let v = gv[(start + i) % gv.len()];
+                local.entry(v).or_insert_with(|| {
+                    source.push(v);
+                    (source.len() - 1) as u32
+                });
+            }
+        }
+    }
+    let mut starts = vec![0u32];
+    let mut verts = Vec::new();
+    let mut tags: HashMap<(u32, u32), EdgeTag> = HashMap::new();
+    let mut key_out = vec![source.len() as u32, faces.len() as u32];
+    for (n, &g) in faces.iter().enumerate() {
+        let gv: Vec<u32> = src.face(g).iter().map(|v| local[v]).collect();
+        let rot = if n == 0 {
+            0
+        } else {
+            (0..gv.len()).min_by_key(|&i| gv[i]).unwrap_or(0)
+        };
+        let ids = &src.face_edges
+            [src.face_starts[g as usize] as usize..src.face_starts[g as usize + 1] as usize];
+        for i in 0..gv.len() {
+            let (a, b) = (gv[i], gv[(i + 1) % gv.len()]);
+            tags.insert(key(a, b), src.edge_tags[ids[i] as usize]);
+        }
+        key_out.push(gv.len() as u32);
+        for i in 0..gv.len() {
+            verts.push(gv[(rot + i) % gv.len()]);
+            key_out.push(gv[(rot + i) % gv.len()]);
+        }
+        starts.push(verts.len() as u32);
+    }
+    let topo = Topo::new(source.len(), starts, verts, |a, b| {
+        tags.get(&(a, b)).copied().unwrap_or_default()
+    });
+    for t in &topo.edge_tags {
+        key_out.push(u32::from(t.sharp) | (u32::from(t.open) << 1));
+    }
+    Neighbourhood {
+        topo,
+        source,
+        key: key_out,
+    }
+}
+
+/// Parameters of the corners of a patch.
+fn corner_params(scheme: Scheme) -> &'static [[f64; 2]] {
+    match scheme {
+        Scheme::Loop => &[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]],
+        _ => &[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+    }
+}
+
+/// Parameter maps of the children that [`Topo::refine`] makes of face 0, in its order.
+fn child_maps(scheme: Scheme) -> Vec<ChildMap> {
+    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+    let c = corner_params(scheme);
+    match scheme {
+        Scheme::Loop => {
+            let (m0, m1, m2) = (mid(c[0], c[1]), mid(c[1], c[2]), mid(c[2], c[0]));
+            vec![
+                ChildMap::new(c[0], m0, m2),
+                ChildMap::new(m0, c[1], m1),
+                ChildMap::new(m2, m1, c[2]),
+                ChildMap::new(m1, m2, m0),
+            ]
+        }
+        _ => (0..4)
+            .map(|i| ChildMap::new(c[i], mid(c[i], c[(i + 1) % 4]), mid(c[i], c[(i + 3) % 4])))
+            .collect(),
+    }
+}
+
+/// Which child of face 0 holds (u, v), in the order of [`child_maps`].
+fn pick_child(scheme: Scheme, u: f64, v: f64) -> usize {
+    match scheme {
+        Scheme::Loop => {
+            if u >= 0.5 {
+                1
+            } else if v >= 0.5 {
+                2
+            } else if u + v <= 0.5 {
+                0
+            } else {
+                3
+            }
+        }
+        _ => match (u >= 0.5, v >= 0.5) {
+            (false, false) => 0,
+            (true, false) => 1,
+            (true, true) => 2,
+            (false, true) => 3,
+        },
+    }
+}
+
+fn domain_centre(scheme: Scheme) -> (f64, f64) {
+    match scheme {
+        Scheme::Loop => (1.0 / 3.0, 1.0 / 3.0),
+        _ => (0.5, 0.5),
+    }
+}
+
+/// Lattice coordinates of the neighbourhood's points, unfolded from face 0 across smooth edges.
+fn unfold(topo: &Topo, scheme: Scheme) -> Option<Vec<Option<(i32, i32)>>> {
+    let n = if scheme == Scheme::Loop { 3 } else { 4 };
+    let mut coords: Vec<Option<(i32, i32)>> = vec![None; topo.nv];
+    let start: &[(i32, i32)] = if n == 3 {
+        &[(0, 0), (1, 0), (0, 1)]
+    } else {
+        &[(0, 0), (1, 0), (1, 1), (0, 1)]
+    };
+    if topo.face(0).len() != n {
+        return None;
+    }
+    for (i, &v) in topo.face(0).iter().enumerate() {
+        coords[v as usize] = Some(start[i]);
+    }
+    let mut done = vec![false; topo.num_faces()];
+    done[0] = true;
+    let mut queue = vec![0u32];
+    while let Some(g) = queue.pop() {
+        let gv = topo.face(g).to_vec();
+        let ids = topo.face_edges
+            [topo.face_starts[g as usize] as usize..topo.face_starts[g as usize + 1] as usize]
+            .to_vec();
+        let at = |v: u32, coords: &Vec<Option<(i32, i32)>>| coords[v as usize];
+        for i in 0..n {
+            let e = ids[i];
+            if topo.edge_tags[e as usize].sharp {
+                continue;
+            }
+            let h = topo.other_face(e, g);
+            if h == NO || done[h as usize] {
+                continue;
+            }
+            let hv = topo.face(h);
+            if hv.len() != n {
+                return None;
+            }
+            let (a, b) = (gv[i], gv[(i + 1) % n]);
+            let (pa, pb) = (at(a, &coords)?, at(b, &coords)?);
+            let j = hv.iter().position(|&x| x == a)?;
+            let news: Vec<(u32, (i32, i32))> = if n == 3 {
+                let pc = at(gv[(i + 2) % 3], &coords)?;
+                vec![(hv[(j + 1) % 3], (pa.0 + pb.0 - pc.0, pa.1 + pb.1 - pc.1))]
+            } else {
+                let pp = at(gv[(i + 3) % 4], &coords)?;
+                let pq = at(gv[(i + 2) % 4], &coords)?;
+                vec![
+                    (hv[(j + 1) % 4], (2 * pa.0 - pp.0, 2 * pa.1 - pp.1)),
+                    (hv[(j + 2) % 4], (2 * pb.0 - pq.0, 2 * pb.1 - pq.1)),
+                ]
+            };
+            for (v, p) in news {
+                match coords[v as usize] {
+                    Some(q) if q != p => return None,
+                    _ => coords[v as usize] = Some(p),
+                }
+            }
+            done[h as usize] = true;
+            queue.push(h);
+        }
+    }
+    Some(coords)
+}
+
+/// Whether a corner allows a closed-form patch: smooth with the regular valence, or on a
+/// straight crease/boundary (two sharp edges, two faces on the patch's side) or at a grid
+/// corner (two sharp edges, the patch alone between them) — the last two for quads only.
+fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
+    if !topo.is_complete(c) {
+        return false;
+    }
+    let n = if scheme == Scheme::Loop { 3 } else { 4 };
+    let mut fan = Vec::new();
+    match topo.sharp_count(c) {
+        0 => {
+            topo.fan(c, 0, false, &mut fan);
+            let valence = if n == 3 { 6 } else { 4 };
+            topo.vertex_edges(c).len() == valence && fan.iter().all(|&g| topo.face(g).len() == n)
+        }
+        2 if n == 4 => {
+            topo.fan(c, 0, true, &mut fan);
+            (fan.len() == 1 || fan.len() == 2) && fan.iter().all(|&g| topo.face(g).len() == 4)
+        }
+        _ => false,
+    }
+}
+
+/// The `nb × k` matrix that makes a regular patch's spline control points, or `None` if the
+/// neighbourhood is not regular.
+fn regular_gather(topo: &Topo, scheme: Scheme) -> Option<Vec<f64>> {
+    let corners = topo.face(0).to_vec();
+    if !corners.iter().all(|&c| corner_is_regular(topo, scheme, c)) {
+        return None;
+    }
+    let coords = unfold(topo, scheme)?;
+    let mut at: HashMap<(i32, i32), Option<u32>> = HashMap::new();
+    for (v, c) in coords.iter().enumerate() {
+        if let Some(p) = c {
+            at.entry(*p)
+                .and_modify(|x| *x = None)
+                .or_insert(Some(v as u32));
+        }
+    }
+    let find = |p: (i32, i32)| at.get(&p).copied().flatten();
+    let k = topo.nv;
+    match scheme {
+        Scheme::Loop => {
+            let mut g = vec![0.0; 12 * k];
+            for (r, &p) in LOOP_LATTICE.iter().enumerate() {
+                g[r * k + find(p)? as usize] = 1.0;
+            }
+            Some(g)
+        }
+        _ => {
+            let ids = &topo.face_edges[0..4];
+            let side = |s: usize| topo.edge_tags[ids[s] as usize].sharp;
+            // Reflection of a phantom index across a sharp side: P(-1) = 2P(0) - P(1).
+            let axis = |i: i32, low: bool, high: bool| -> Vec<(f64, i32)> {
+                match i {
+                    -1 if low => vec![(2.0, 0), (-1.0, 1)],
+                    2 if high => vec![(2.0, 1), (-1.0, 0)],
+                    _ => vec![(1.0, i)],
+                }
+            };
+            let mut g = vec![0.0; 16 * k];
+            for (r, &(i, j)) in bicubic_lattice().iter().enumerate() {
+                for (wi, ii) in axis(i, side(3), side(1)) {
+                    for (wj, jj) in axis(j, side(0), side(2)) {
+                        g[r * k + find((ii, jj))? as usize] += wi * wj;
+                    }
+                }
+            }
+            Some(g)
+        }
+    }
+}
+
+impl Graph {
+    pub fn new(scheme: Scheme) -> Graph {
+        Graph {
+            scheme,
+            nodes: Vec::new(),
+            index: HashMap::new(),
+            pending: Vec::new(),
+        }
+    }
+
+    /// The node of a neighbourhood, building it and everything below it if new.
+    pub fn add(&mut self, nb: Neighbourhood, patch: usize) -> Result<u32, SubdivError> {
+        let id = self.intern(nb.key, nb.topo, patch)?;
+        while let Some((node, topo)) = self.pending.pop() {
+            let built = self.build(&topo, patch)?;
+            self.nodes[node as usize] = built;
+        }
+        Ok(id)
+    }
+
+    fn intern(&mut self, key: Vec<u32>, topo: Topo, patch: usize) -> Result<u32, SubdivError> {
+        if let Some(&id) = self.index.get(&key) {
+            return Ok(id);
+        }
+        if topo.nv > MAX_LOCAL {
+            return Err(SubdivError::NeighbourhoodTooLarge {
+                patch,
+                points: topo.nv,
+                max: MAX_LOCAL,
+            });
+        }
+        let id = self.nodes.len() as u32;
+        self.nodes.push(Node::Pending);
+        self.index.insert(key, id);
+        self.pending.push((id, topo));
+        Ok(id)
+    }
+
+    fn build(&mut self, topo: &Topo, patch: usize) -> Result<Node, SubdivError> {
+        let k = topo.nv;
+        if let Some(gather) = regular_gather(topo, self.scheme) {
+            return Ok(Node::Regular { k, gather });
+        }
+        let refined = topo.refine(self.scheme);
+        let maps = child_maps(self.scheme);
+        let mut children = Vec::with_capacity(maps.len());
+        for (ci, map) in maps.into_iter().enumerate() {
+            let nb = neighbourhood(&refined.topo, ci as u32);
+            let kc = nb.topo.nv;
+            let mut mat = vec![0.0; kc * k];
+            for (row, &p) in nb.source.iter().enumerate() {
+                let stencil = refined.points[p as usize]
+                    .as_ref()
+                    .ok_or(SubdivError::Unevaluable { patch })?;
+                for &(j, w) in stencil {
+                    mat[row * k + j as usize] += w;
+                }
+            }
+            let node = self.intern(nb.key, nb.topo, patch)?;
+            children.push(Child {
+                node,
+                k: kc,
+                mat,
+                map,
+            });
+        }
+        let corner_masks = topo
+            .face(0)
+            .iter()
+            .map(|&c| {
+                let s: Stencil = topo
+                    .limit_stencil(self.scheme, c)
+                    .ok_or(SubdivError::Unevaluable { patch })?;
+                Ok(s.into_iter().map(|(i, w)| (i as u16, w)).collect())
+            })
+            .collect::<Result<Vec<_>, SubdivError>>()?;
+        Ok(Node::Split {
+            k,
+            children,
+            corner_masks,
+        })
+    }
+
+    /// For a regular node whose gather only picks points: the picked local indices in basis
+    /// order.
+    pub fn direct_picks(&self, node: u32) -> Option<Vec<u32>> {
+        let Node::Regular { k, gather } = &self.nodes[node as usize] else {
+            return None;
+        };
+        gather
+            .chunks(*k)
+            .map(|row| {
+                let mut nz = row.iter().enumerate().filter(|(_, &w)| w != 0.0);
+                match (nz.next(), nz.next()) {
+                    (Some((j, &w)), None) if w == 1.0 => Some(j as u32),
+                    _ => None,
+                }
+            })
+            .collect()
+    }
+
+    /// Follows the children that hold (u, v) down to a regular node.
+    fn descend(&self, root: u32, u: f64, v: f64) -> Path {
+        let mut path = Path {
+            steps: [0; MAX_DEPTH + EXTRA_DEPTH],
+            len: 0,
+            leaf: root,
+            u,
+            v,
+            g: [[1.0, 0.0], [0.0, 1.0]],
+            cap: None,
+        };
+        let mut node = root;
+        loop {
+            match &self.nodes[node as usize] {
+                Node::Split { children, .. } => {
+                    if path.len == MAX_DEPTH && path.cap.is_none() {
+                        path.cap = Some((path.len, nearest_corner(self.scheme, path.u, path.v)));
+                        (path.u, path.v) = domain_centre(self.scheme);
+                    }
+                    if path.len == path.steps.len() {
+                        path.leaf = node;
+                        return path;
+                    }
+                    let ci = pick_child(self.scheme, path.u, path.v);
+                    let ch = &children[ci];
+                    (path.u, path.v) = ch.map.apply(path.u, path.v);
+                    path.g = mul2(ch.map.m, path.g);
+                    path.steps[path.len] = ci as u8;
+                    path.len += 1;
+                    node = ch.node;
+                }
+                _ => {
+                    path.leaf = node;
+                    return path;
+                }
+            }
+        }
+    }
+
+    /// Limit point and derivatives at (u, v) of the patch `root` whose local points are `pts`.
+    pub fn eval(&self, root: u32, pts: &[Point3], u: f64, v: f64) -> LimitEval {
+        let path = self.descend(root, u, v);
+        let mut a = [Vec3::ZERO; MAX_LOCAL];
+        let mut b = [Vec3::ZERO; MAX_LOCAL];
+        let mut k = pts.len().min(MAX_LOCAL);
+        // Points are kept relative to a moving origin (the first local point) so that deep
+        // levels, whose points differ by 2^-depth, keep full relative precision and the
+        // derivatives (scaled back up by 2^depth) do not suffer cancellation.
+        let mut offset = pts.first().copied().unwrap_or_default();
+        for (q, &p) in a.iter_mut().zip(&pts[..k]) {
+            *q = p - offset;
+        }
+        let mut node = root;
+        let mut capped = None;
+        for d in 0..path.len {
+            if let (Some((cd, corner)), Node::Split { corner_masks, .. }) =
+                (path.cap, &self.nodes[node as usize])
+            {
+                if cd == d {
+                    capped = Some(
+                        offset
+                            + corner_masks[corner]
+                                .iter()
+                                .map(|&(i, w)| a[i as usize] * w)
+                                .sum::<Vec3>(),
+                    );
+                }
+            }
+            let Node::Split { children, .. } = &self.nodes[node as usize] else {
+                break;
+            };
+            let ch = &children[path.steps[d] as usize];
+            for (r, out) in b[..ch.k].iter_mut().enumerate() {
+                let row = &ch.mat[r * k..(r + 1) * k];
+                *out = row.iter().zip(&a[..k]).map(|(&w, &p)| p * w).sum();
+            }
+            std::mem::swap(&mut a, &mut b);
+            k = ch.k;
+            node = ch.node;
+            let c = a[0];
+            offset += c;
+            for q in &mut a[..k] {
+                *q -= c;
+            }
+        }
+        let mut out = match &self.nodes[path.leaf as usize] {
+            Node::Regular { gather, .. } => self.eval_regular(gather, &a[..k], path.u, path.v),
+            _ => LimitEval {
+                point: a[..k].iter().sum::<Vec3>() / k.max(1) as f64,
+                ..LimitEval::default()
+            },
+        };
+        out.point += offset;
+        chain(&mut out, path.g);
+        if let Some(p) = capped {
+            out.point = p;
+        }
+        out
+    }
+
+    fn eval_regular(&self, gather: &[f64], pts: &[Point3], u: f64, v: f64) -> LimitEval {
+        let k = pts.len();
+        let mut cp = [Vec3::ZERO; 16];
+        for (r, c) in cp.iter_mut().enumerate().take(gather.len() / k.max(1)) {
+            *c = gather[r * k..(r + 1) * k]
+                .iter()
+                .zip(pts)
+                .map(|(&w, &p)| p * w)
+                .sum();
+        }
+        match self.scheme {
+            Scheme::Loop => combine(&loop_box(u, v), &cp[..12]),
+            _ => combine(&bicubic(u, v), &cp[..16]),
+        }
+    }
+
+    /// Weights of the patch's local points for the limit position at (u, v).
+    pub fn stencil(&self, root: u32, u: f64, v: f64, out: &mut Vec<f64>) {
+        let path = self.descend(root, u, v);
+        let mut nodes = Vec::with_capacity(path.len + 1);
+        let mut node = root;
+        nodes.push(node);
+        for d in 0..path.len {
+            let Node::Split { children, .. } = &self.nodes[node as usize] else {
+                break;
+            };
+            node = children[path.steps[d] as usize].node;
+            nodes.push(node);
+        }
+        let mut w: Vec<f64> = match &self.nodes[path.leaf as usize] {
+            Node::Regular { k, gather } => {
+                let basis: Vec<f64> = match self.scheme {
+                    Scheme::Loop => loop_box(path.u, path.v)[0].to_vec(),
+                    _ => bicubic(path.u, path.v)[0].to_vec(),
+                };
+                (0..*k)
+                    .map(|j| {
+                        basis
+                            .iter()
+                            .enumerate()
+                            .map(|(r, b)| b * gather[r * k + j])
+                            .sum()
+                    })
+                    .collect()
+            }
+            n => {
+                let k = match n {
+                    Node::Split { k, .. } => *k,
+                    _ => 0,
+                };
+                vec![1.0 / k.max(1) as f64; k]
+            }
+        };
+        for d in (0..path.len).rev() {
+            let Node::Split {
+                k,
+                children,
+                corner_masks,
+            } = &self.nodes[nodes[d] as usize]
+            else {
+                continue;
+            };
+            if let Some((cd, corner)) = path.cap {
+                if cd == d {
+                    w = vec![0.0; *k];
+                    for &(i, m) in &corner_masks[corner] {
+                        w[i as usize] += m;
+                    }
+                    continue;
+                }
+            }
+            let ch = &children[path.steps[d] as usize];
+            let mut up = vec![0.0; *k];
+            for (r, &wr) in w.iter().enumerate() {
+                if wr != 0.0 {
+                    for (j, u) in up.iter_mut().enumerate() {
+                        *u += wr * ch.mat[r * k + j];
+                    }
+                }
+            }
+            w = up;
+        }
+        out.clear();
+        out.extend(w);
+    }
+}
+
+/// A descent through the graph: which child at each level, and the leaf's parameters.
+struct Path {
+    steps: [u8; MAX_DEPTH + EXTRA_DEPTH],
+    len: usize,
+    leaf: u32,
+    u: f64,
+    v: f64,
+    /// Jacobian of leaf parameters with respect to patch parameters.
+    g: [[f64; 2]; 2],
+    /// Depth and corner where the parameter was taken to be at a corner's limit point.
+    cap: Option<(usize, usize)>,
+}
+
+fn nearest_corner(scheme: Scheme, u: f64, v: f64) -> usize {
+    let c = corner_params(scheme);
+    (0..c.len())
+        .min_by(|&i, &j| {
+            let d = |k: usize| (c[k][0] - u).powi(2) + (c[k][1] - v).powi(2);
+            d(i).total_cmp(&d(j))
+        })
+        .unwrap_or(0)
+}
+
+fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let mut c = [[0.0; 2]; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+        }
+    }
+    c
+}
+
+/// Sums basis weights times control points.
+pub(crate) fn combine<const N: usize>(w: &[[f64; N]; 6], cp: &[Point3]) -> LimitEval {
+    let s = |d: usize| -> Vec3 { w[d].iter().zip(cp).map(|(&w, &p)| p * w).sum() };
+    LimitEval {
+        point: s(0),
+        du: s(1),
+        dv: s(2),
+        duu: s(3),
+        duv: s(4),
+        dvv: s(5),
+    }
+}
+
+/// Turns derivatives with respect to leaf parameters into ones with respect to the patch's,
+/// where leaf = g · patch + const.
+pub(crate) fn chain(e: &mut LimitEval, g: [[f64; 2]; 2]) {
+    let (du, dv) = (e.du, e.dv);
+    e.du = du * g[0][0] + dv * g[1][0];
+    e.dv = du * g[0][1] + dv * g[1][1];
+    let h = [[e.duu, e.duv], [e.duv, e.dvv]];
+    let second = |a: usize, b: usize| -> Vec3 {
+        let mut s = Vec3::ZERO;
+        for i in 0..2 {
+            for j in 0..2 {
+                s += h[i][j] * (g[i][a] * g[j][b]);
+            }
+        }
+        s
+    };
+    e.duu = second(0, 0);
+    e.duv = second(0, 1);
+    e.dvv = second(1, 1);
+}

@@ -1,0 +1,69 @@
+//! Refinement of whole control meshes: one step of a scheme, several steps, and the conversion
+//! of any polygon mesh into quads for the quad schemes.
+
+use super::surface::topo_of;
+use super::topo::Topo;
+use super::{Scheme, SubdivError};
+use crate::geom::Point3;
+use crate::mesh::ControlMesh;
+
+/// One refinement step of `scheme`. Loop needs triangles; Catmull–Clark and Doo–Sabin take any
+/// polygons. Boundary edges follow the curve rules (cubic B-spline for Loop and Catmull–Clark,
+/// Chaikin's quadratic for Doo–Sabin); sharp edges follow the crease rules and stay sharp.
+pub fn refine(scheme: Scheme, mesh: &ControlMesh) -> Result<ControlMesh, SubdivError> {
+    if scheme == Scheme::Loop {
+        if let Some(f) = (0..mesh.num_faces() as u32).find(|&f| mesh.face_len(f) != 3) {
+            return Err(SubdivError::WrongFaceSize {
+                face: f as usize,
+                len: mesh.face_len(f),
+                scheme,
+            });
+        }
+    }
+    let topo = topo_of(mesh);
+    let refined = topo.refine(scheme);
+    let old = mesh.positions();
+    let positions = refined
+        .points
+        .iter()
+        .map(|s| {
+            s.as_ref()
+                .map(|s| s.iter().map(|&(i, w)| old[i as usize] * w).sum::<Point3>())
+                .ok_or(SubdivError::Unevaluable { patch: 0 })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    rebuild(positions, &refined.topo)
+}
+
+/// `levels` refinement steps.
+pub fn refine_levels(
+    scheme: Scheme,
+    mesh: &ControlMesh,
+    levels: usize,
+) -> Result<ControlMesh, SubdivError> {
+    let mut m = mesh.clone();
+    for _ in 0..levels {
+        m = refine(scheme, &m)?;
+    }
+    Ok(m)
+}
+
+/// A quad mesh from any polygon mesh by one Catmull–Clark step (each n-gon gives n quads).
+pub fn quadrangulate(mesh: &ControlMesh) -> Result<ControlMesh, SubdivError> {
+    refine(Scheme::CatmullClark, mesh)
+}
+
+fn rebuild(positions: Vec<Point3>, topo: &Topo) -> Result<ControlMesh, SubdivError> {
+    let faces = (0..topo.num_faces() as u32).map(|f| topo.face(f).to_vec());
+    let mut mesh = ControlMesh::from_faces(positions, faces).map_err(|e| match e {
+        crate::mesh::ControlMeshError::Mesh(m) => SubdivError::Mesh(m),
+        crate::mesh::ControlMeshError::Topology(t) => SubdivError::Topology(t),
+    })?;
+    for (e, &[a, b]) in topo.edges.iter().enumerate() {
+        let tag = topo.edge_tags[e];
+        if tag.sharp && !tag.open {
+            mesh.set_sharp(a, b, true)?;
+        }
+    }
+    Ok(mesh)
+}

@@ -1,0 +1,346 @@
+//! [`SubdivSurface`]: the limit surface of a control mesh under one scheme, with everything
+//! topological precomputed so evaluation after moving control points is only weighted sums.
+
+use super::patch::{combine, neighbourhood, Graph};
+use super::topo::{EdgeTag, Topo};
+use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
+use crate::geom::{Point3, Vec3};
+use crate::mesh::{ControlMesh, NONE};
+
+/// Where a patch's local points come from, and how to evaluate it.
+#[derive(Clone, Copy, Debug)]
+struct Patch {
+    node: u32,
+    start: u32,
+    len: u32,
+    /// The patch is a plain box spline / B-spline over `ctrl[start..start + len]` in basis order.
+    direct: bool,
+}
+
+/// The limit surface of a Loop or Catmull–Clark control mesh.
+pub struct SubdivSurface {
+    scheme: Scheme,
+    mesh: ControlMesh,
+    graph: Graph,
+    patches: Vec<Patch>,
+    ctrl: Vec<u32>,
+    /// Limit stencil of every control vertex (limit masks), flattened.
+    limit_starts: Vec<u32>,
+    limit_weights: Vec<(u32, f64)>,
+}
+
+/// Builds the edge-tagged topology of a control mesh.
+pub(crate) fn topo_of(mesh: &ControlMesh) -> Topo {
+    let mut starts = vec![0u32];
+    let mut verts = Vec::new();
+    for f in 0..mesh.num_faces() as u32 {
+        verts.extend(mesh.face_vertices(f));
+        starts.push(verts.len() as u32);
+    }
+    Topo::new(mesh.num_vertices(), starts, verts, |a, b| {
+        let h = mesh
+            .find_half_edge(a, b)
+            .or_else(|| mesh.find_half_edge(b, a));
+        match h {
+            Some(h) => EdgeTag {
+                sharp: mesh.is_sharp(h),
+                open: mesh.is_boundary_edge(h),
+            },
+            None => EdgeTag::default(),
+        }
+    })
+}
+
+impl SubdivSurface {
+    /// The limit surface of `mesh` under `scheme` (Loop needs triangles, Catmull–Clark quads).
+    pub fn try_new(scheme: Scheme, mesh: ControlMesh) -> Result<SubdivSurface, SubdivError> {
+        let needed = match scheme {
+            Scheme::Loop => 3,
+            Scheme::CatmullClark => 4,
+            Scheme::DooSabin => {
+                return Err(SubdivError::Unsupported {
+                    what: "Doo–Sabin limit evaluation",
+                })
+            }
+        };
+        if mesh.num_faces() == 0 {
+            return Err(SubdivError::NoFaces);
+        }
+        for f in 0..mesh.num_faces() as u32 {
+            let len = mesh.face_len(f);
+            if len != needed {
+                return Err(SubdivError::WrongFaceSize {
+                    face: f as usize,
+                    len,
+                    scheme,
+                });
+            }
+        }
+        let topo = topo_of(&mesh);
+        let mut graph = Graph::new(scheme);
+        let mut patches = Vec::with_capacity(mesh.num_faces());
+        let mut ctrl = Vec::new();
+        for f in 0..mesh.num_faces() {
+            let nb = neighbourhood(&topo, f as u32);
+            let source = nb.source.clone();
+            let node = graph.add(nb, f)?;
+            let start = ctrl.len() as u32;
+            match graph.direct_picks(node) {
+                Some(picks) => {
+                    ctrl.extend(picks.iter().map(|&p| source[p as usize]));
+                    patches.push(Patch {
+                        node,
+                        start,
+                        len: picks.len() as u32,
+                        direct: true,
+                    });
+                }
+                None => {
+                    ctrl.extend_from_slice(&source);
+                    patches.push(Patch {
+                        node,
+                        start,
+                        len: source.len() as u32,
+                        direct: false,
+                    });
+                }
+            }
+        }
+        let mut limit_starts = vec![0u32];
+        let mut limit_weights = Vec::new();
+        for v in 0..mesh.num_vertices() as u32 {
+            let s = topo
+                .limit_stencil(scheme, v)
+                .ok_or(SubdivError::Unevaluable { patch: 0 })?;
+            limit_weights.extend(s);
+            limit_starts.push(limit_weights.len() as u32);
+        }
+        Ok(SubdivSurface {
+            scheme,
+            mesh,
+            graph,
+            patches,
+            ctrl,
+            limit_starts,
+            limit_weights,
+        })
+    }
+
+    /// The scheme.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The control mesh (connectivity and current control points).
+    pub fn control_mesh(&self) -> &ControlMesh {
+        &self.mesh
+    }
+
+    /// Exact limit positions of the control vertices (limit masks).
+    pub fn limit_positions(&self) -> Vec<Point3> {
+        let p = self.mesh.positions();
+        (0..self.mesh.num_vertices())
+            .map(|v| {
+                let s = &self.limit_weights
+                    [self.limit_starts[v] as usize..self.limit_starts[v + 1] as usize];
+                s.iter().map(|&(i, w)| p[i as usize] * w).sum()
+            })
+            .collect()
+    }
+
+    /// Unit limit normals of the control vertices (zero for vertices in no face), from the
+    /// limit tangent plane of a patch at that corner.
+    pub fn limit_normals(&self) -> Vec<Vec3> {
+        (0..self.mesh.num_vertices() as u32)
+            .map(|v| {
+                let h = self.mesh.vertex_half_edge(v);
+                if h == NONE {
+                    return Vec3::ZERO;
+                }
+                let f = self.mesh.face_of(h);
+                let corner = self.mesh.face_vertices(f).position(|x| x == v).unwrap_or(0);
+                let (u, w) = corner_uv(self.scheme, corner);
+                let e = self.eval(SurfaceParam { patch: f, u, v: w });
+                e.du.cross(e.dv).normalize_or_zero()
+            })
+            .collect()
+    }
+
+    fn local_points<'a>(
+        &self,
+        p: &Patch,
+        buf: &'a mut [Point3; super::patch::MAX_LOCAL],
+    ) -> &'a [Point3] {
+        let pts = self.mesh.positions();
+        let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
+        for (b, &i) in buf.iter_mut().zip(idx) {
+            *b = pts[i as usize];
+        }
+        &buf[..idx.len()]
+    }
+
+    fn patch(&self, at: SurfaceParam) -> Option<(&Patch, f64, f64)> {
+        let p = self.patches.get(at.patch as usize)?;
+        let clean = |x: f64| if x.is_finite() { x } else { 0.0 };
+        Some((p, clean(at.u), clean(at.v)))
+    }
+
+    /// Samples every patch on a regular grid with `segments` intervals per edge: positions,
+    /// normals, triangles and the parameter of each sample, for display and for seeding
+    /// closest-point searches.
+    pub fn tessellate(&self, segments: usize) -> Tessellation {
+        let n = segments.max(1);
+        let mut t = Tessellation::default();
+        for patch in 0..self.patches.len() as u32 {
+            let base = t.positions.len() as u32;
+            let mut grid = Vec::new();
+            for j in 0..=n {
+                for i in 0..=n {
+                    let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                    if self.scheme == Scheme::Loop && i + j > n {
+                        continue;
+                    }
+                    grid.push((i, j));
+                    let e = self.eval(SurfaceParam { patch, u, v });
+                    t.positions.push(e.point);
+                    t.normals.push(e.du.cross(e.dv).normalize_or_zero());
+                    t.params.push(SurfaceParam { patch, u, v });
+                }
+            }
+            let id = |i: usize, j: usize| {
+                grid.iter()
+                    .position(|&g| g == (i, j))
+                    .map(|p| base + p as u32)
+            };
+            for j in 0..n {
+                for i in 0..n {
+                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                    if let (Some(a), Some(b), Some(d)) = (a, b, d) {
+                        t.triangles.push([a, b, d]);
+                        if let Some(c) = c {
+                            t.triangles.push([b, c, d]);
+                        }
+                    }
+                }
+            }
+        }
+        t
+    }
+}
+
+/// Parameters of corner `i` of a patch.
+fn corner_uv(scheme: Scheme, i: usize) -> (f64, f64) {
+    match (scheme, i) {
+        (_, 0) => (0.0, 0.0),
+        (_, 1) => (1.0, 0.0),
+        (Scheme::Loop, _) => (0.0, 1.0),
+        (_, 2) => (1.0, 1.0),
+        _ => (0.0, 1.0),
+    }
+}
+
+/// A sampled limit surface.
+#[derive(Clone, Debug, Default)]
+pub struct Tessellation {
+    /// Sample positions.
+    pub positions: Vec<Point3>,
+    /// Unit normals at the samples.
+    pub normals: Vec<Vec3>,
+    /// Triangles over the samples (counter-clockwise like the control faces).
+    pub triangles: Vec<[u32; 3]>,
+    /// Patch and parameters of each sample.
+    pub params: Vec<SurfaceParam>,
+}
+
+impl LimitSurface for SubdivSurface {
+    fn domain(&self) -> PatchDomain {
+        match self.scheme {
+            Scheme::Loop => PatchDomain::Triangle,
+            _ => PatchDomain::Square,
+        }
+    }
+
+    fn num_patches(&self) -> usize {
+        self.patches.len()
+    }
+
+    fn control_points(&self) -> &[Point3] {
+        self.mesh.positions()
+    }
+
+    fn set_control_points(&mut self, points: &[Point3]) {
+        self.mesh.set_positions(points);
+    }
+
+    fn eval(&self, at: SurfaceParam) -> LimitEval {
+        let Some((p, u, v)) = self.patch(at) else {
+            return LimitEval::default();
+        };
+        if p.direct {
+            let pts = self.mesh.positions();
+            let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
+            let mut cp = [Point3::ZERO; 16];
+            for (c, &i) in cp.iter_mut().zip(idx) {
+                *c = pts[i as usize];
+            }
+            return match self.scheme {
+                Scheme::Loop => combine(&super::basis::loop_box(u, v), &cp[..12]),
+                _ => combine(&super::basis::bicubic(u, v), &cp[..16]),
+            };
+        }
+        let mut buf = [Point3::ZERO; super::patch::MAX_LOCAL];
+        let local = self.local_points(p, &mut buf);
+        self.graph.eval(p.node, local, u, v)
+    }
+
+    fn stencil(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>) {
+        let Some((p, u, v)) = self.patch(at) else {
+            return;
+        };
+        let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
+        let weights: Vec<f64> = if p.direct {
+            match self.scheme {
+                Scheme::Loop => super::basis::loop_box(u, v)[0].to_vec(),
+                _ => super::basis::bicubic(u, v)[0].to_vec(),
+            }
+        } else {
+            let mut w = Vec::with_capacity(idx.len());
+            self.graph.stencil(p.node, u, v, &mut w);
+            w
+        };
+        let start = out.len();
+        for (&i, &w) in idx.iter().zip(&weights) {
+            if w != 0.0 {
+                match out[start..].iter_mut().find(|(j, _)| *j == i) {
+                    Some(e) => e.1 += w,
+                    None => out.push((i, w)),
+                }
+            }
+        }
+    }
+
+    fn corner_weights(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>) {
+        let Some((_, u, v)) = self.patch(at) else {
+            return;
+        };
+        let corners: Vec<u32> = self.mesh.face_vertices(at.patch).collect();
+        let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
+        match self.scheme {
+            Scheme::Loop => {
+                let s = u + v;
+                let (u, v) = if s > 1.0 { (u / s, v / s) } else { (u, v) };
+                out.extend([(corners[0], 1.0 - u - v), (corners[1], u), (corners[2], v)]);
+            }
+            _ => out.extend([
+                (corners[0], (1.0 - u) * (1.0 - v)),
+                (corners[1], u * (1.0 - v)),
+                (corners[2], u * v),
+                (corners[3], (1.0 - u) * v),
+            ]),
+        }
+    }
+
+    fn relocate(&self, patch: u32, u: f64, v: f64) -> SurfaceParam {
+        super::walk::relocate(&self.mesh, self.scheme, patch, u, v)
+    }
+}

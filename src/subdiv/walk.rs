@@ -1,0 +1,120 @@
+//! Walking a parameter across patch edges: after a Newton step leaves a patch, find the patch
+//! that holds the point, mapping parameters through the shared edge (neighbouring patches are
+//! unfolded into one plane across it), and clamp onto the domain at open boundaries.
+
+use super::{Scheme, SurfaceParam};
+use crate::mesh::{ControlMesh, NONE};
+
+/// Patches crossed at most by one relocation.
+const MAX_STEPS: usize = 32;
+
+pub(crate) fn relocate(
+    mesh: &ControlMesh,
+    scheme: Scheme,
+    patch: u32,
+    u: f64,
+    v: f64,
+) -> SurfaceParam {
+    let clean = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let (u, v) = (clean(u), clean(v));
+    if patch as usize >= mesh.num_faces() {
+        return SurfaceParam {
+            patch: 0,
+            u: 0.0,
+            v: 0.0,
+        };
+    }
+    match scheme {
+        Scheme::Loop => walk_triangles(mesh, patch, u, v),
+        _ => walk_quads(mesh, patch, u, v),
+    }
+}
+
+fn walk_triangles(mesh: &ControlMesh, mut f: u32, u: f64, v: f64) -> SurfaceParam {
+    let mut w = [1.0 - u - v, u, v];
+    for _ in 0..MAX_STEPS {
+        let k = (0..3).min_by(|&a, &b| w[a].total_cmp(&w[b])).unwrap_or(0);
+        if w[k] >= 0.0 {
+            break;
+        }
+        // The edge opposite corner k runs from corner k+1 to corner k+2.
+        let h = mesh.face_half_edges(f).nth((k + 1) % 3).unwrap_or(NONE);
+        let t = if h == NONE { NONE } else { mesh.twin(h) };
+        if t == NONE {
+            break;
+        }
+        let (a, b) = (mesh.origin(h), mesh.target(h));
+        let g = mesh.face_of(t);
+        let mut next = [0.0; 3];
+        for (i, c) in mesh.face_vertices(g).enumerate() {
+            next[i] = if c == a {
+                w[(k + 1) % 3] + w[k]
+            } else if c == b {
+                w[(k + 2) % 3] + w[k]
+            } else {
+                -w[k]
+            };
+        }
+        w = next;
+        f = g;
+    }
+    // Clamp onto the triangle: drop negative weights and renormalise.
+    for x in &mut w {
+        *x = x.max(0.0);
+    }
+    let s: f64 = w.iter().sum();
+    let (u, v) = if s > 0.0 {
+        (w[1] / s, w[2] / s)
+    } else {
+        (0.0, 0.0)
+    };
+    SurfaceParam { patch: f, u, v }
+}
+
+/// (along, outward) coordinates of (u, v) relative to side `j` of the unit square.
+fn to_edge(j: usize, u: f64, v: f64) -> (f64, f64) {
+    match j {
+        0 => (u, -v),
+        1 => (v, u - 1.0),
+        2 => (1.0 - u, v - 1.0),
+        _ => (1.0 - v, -u),
+    }
+}
+
+fn from_edge(j: usize, t: f64, s: f64) -> (f64, f64) {
+    match j {
+        0 => (t, -s),
+        1 => (1.0 + s, t),
+        2 => (1.0 - t, 1.0 + s),
+        _ => (-s, 1.0 - t),
+    }
+}
+
+fn walk_quads(mesh: &ControlMesh, mut f: u32, mut u: f64, mut v: f64) -> SurfaceParam {
+    for _ in 0..MAX_STEPS {
+        let out = [-v, u - 1.0, v - 1.0, -u];
+        let j = (0..4)
+            .max_by(|&a, &b| out[a].total_cmp(&out[b]))
+            .unwrap_or(0);
+        if out[j] <= 0.0 {
+            break;
+        }
+        let h = mesh.face_half_edges(f).nth(j).unwrap_or(NONE);
+        let t = if h == NONE { NONE } else { mesh.twin(h) };
+        if t == NONE {
+            break;
+        }
+        let g = mesh.face_of(t);
+        let Some(k) = mesh.face_half_edges(g).position(|x| x == t) else {
+            break;
+        };
+        let (along, outward) = to_edge(j, u, v);
+        (u, v) = from_edge(k, 1.0 - along, -outward);
+        f = g;
+    }
+    SurfaceParam {
+        patch: f,
+        u: u.clamp(0.0, 1.0),
+        v: v.clamp(0.0, 1.0),
+    }
+}

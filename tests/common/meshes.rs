@@ -1,0 +1,149 @@
+//! Small control meshes for the subdivision tests.
+
+use geofit::geom::Point3;
+use geofit::mesh::PolyMesh;
+
+/// Icosahedron: every vertex has valence 5 (all patches extraordinary).
+pub fn icosahedron() -> PolyMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let p = vec![
+        Point3::new(-1.0, t, 0.0),
+        Point3::new(1.0, t, 0.0),
+        Point3::new(-1.0, -t, 0.0),
+        Point3::new(1.0, -t, 0.0),
+        Point3::new(0.0, -1.0, t),
+        Point3::new(0.0, 1.0, t),
+        Point3::new(0.0, -1.0, -t),
+        Point3::new(0.0, 1.0, -t),
+        Point3::new(t, 0.0, -1.0),
+        Point3::new(t, 0.0, 1.0),
+        Point3::new(-t, 0.0, -1.0),
+        Point3::new(-t, 0.0, 1.0),
+    ];
+    let f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    PolyMesh::try_new(p, f).unwrap()
+}
+
+/// Octahedron: valence 4 everywhere.
+pub fn octahedron() -> PolyMesh {
+    let p = vec![
+        Point3::new(1.0, 0.0, 0.0),
+        Point3::new(-1.0, 0.0, 0.0),
+        Point3::new(0.0, 1.0, 0.0),
+        Point3::new(0.0, -1.0, 0.0),
+        Point3::new(0.0, 0.0, 1.0),
+        Point3::new(0.0, 0.0, -1.0),
+    ];
+    let f: Vec<[u32; 3]> = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    PolyMesh::try_new(p, f).unwrap()
+}
+
+/// An n × n grid of unit squares in the plane z = h(x, y), each split into two triangles along
+/// the same diagonal (a regular triangulation: interior valence 6).
+pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64, j as f64);
+            p.push(Point3::new(x, y, h(x, y)));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut f = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            f.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
+            f.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    PolyMesh::try_new(p, f).unwrap()
+}
+
+/// An n × n quad grid in the plane z = h(x, y).
+pub fn quad_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64, j as f64);
+            p.push(Point3::new(x, y, h(x, y)));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut f = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    PolyMesh::try_new(p, f).unwrap()
+}
+
+/// A cube of six quads (valence 3 everywhere).
+pub fn cube() -> PolyMesh {
+    let mut p = Vec::new();
+    for z in [0.0, 1.0] {
+        for y in [0.0, 1.0] {
+            for x in [0.0, 1.0] {
+                p.push(Point3::new(x, y, z));
+            }
+        }
+    }
+    let f: Vec<[u32; 4]> = vec![
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    PolyMesh::try_new(p, f).unwrap()
+}
+
+/// A deterministic pseudo-random perturbation of every vertex by up to `amount`.
+pub fn jitter(mesh: &PolyMesh, amount: f64, seed: u64) -> PolyMesh {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    let mut rnd = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    let p = mesh
+        .positions()
+        .iter()
+        .map(|&q| q + Point3::new(rnd(), rnd(), rnd()) * amount)
+        .collect();
+    PolyMesh::try_new(p, mesh.faces()).unwrap()
+}

@@ -1,0 +1,305 @@
+//! Loop subdivision: refinement rules and exact limit evaluation (regular, extraordinary,
+//! boundary), checked against each other and against closed forms.
+
+mod common;
+
+use common::meshes::{icosahedron, jitter, octahedron, tri_grid};
+use geofit::geom::{Point3, Vec3};
+use geofit::mesh::{ControlMesh, PolyMesh};
+use geofit::subdiv::{refine, LimitEval, LimitSurface, LoopSurface, Scheme, SurfaceParam};
+
+fn loop_surface(mesh: &PolyMesh) -> LoopSurface {
+    LoopSurface::try_new(mesh).expect("valid control mesh")
+}
+
+fn refined(mesh: &PolyMesh) -> LoopSurface {
+    let cm = ControlMesh::try_new(mesh).unwrap();
+    LoopSurface::from_control_mesh(refine(Scheme::Loop, &cm).unwrap()).unwrap()
+}
+
+/// Parent parameters of child `c` of a triangle (the order refinement makes them in).
+fn to_parent(c: usize, u: f64, v: f64) -> (f64, f64, f64) {
+    match c {
+        0 => (u / 2.0, v / 2.0, 0.5),
+        1 => (0.5 + u / 2.0, v / 2.0, 0.5),
+        2 => (u / 2.0, 0.5 + v / 2.0, 0.5),
+        _ => (0.5 - u / 2.0, 0.5 - v / 2.0, -0.5),
+    }
+}
+
+fn samples() -> Vec<(f64, f64)> {
+    let mut out = vec![
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (0.0, 1.0),
+        (0.5, 0.5),
+        (1e-7, 2e-7),
+        (0.3, 0.0),
+        (0.0, 0.7),
+    ];
+    for i in 0..6 {
+        for j in 0..6 - i {
+            out.push((i as f64 / 6.0 + 0.013, j as f64 / 6.0 + 0.007));
+        }
+    }
+    out.retain(|&(u, v)| u + v <= 1.0);
+    out
+}
+
+fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
+    (a - b).length() <= tol * (1.0 + a.length().max(b.length()))
+}
+
+/// The surface of the once-refined mesh is the same surface: exact evaluation must agree
+/// everywhere, including at extraordinary vertices and boundaries.
+fn check_refinement_invariance(mesh: &PolyMesh) {
+    let s0 = loop_surface(mesh);
+    let s1 = refined(mesh);
+    assert_eq!(s1.num_patches(), 4 * s0.num_patches());
+    for f in 0..s0.num_patches() as u32 {
+        for c in 0..4 {
+            for &(u, v) in &samples() {
+                let (pu, pv, scale) = to_parent(c, u, v);
+                let a = s0.eval(SurfaceParam {
+                    patch: f,
+                    u: pu,
+                    v: pv,
+                });
+                let b = s1.eval(SurfaceParam {
+                    patch: 4 * f + c as u32,
+                    u,
+                    v,
+                });
+                assert!(
+                    close(a.point, b.point, 1e-10),
+                    "patch {f} child {c} ({u},{v}): {:?} vs {:?}",
+                    a.point,
+                    b.point
+                );
+                // Near extraordinary vertices derivatives of the two parameterisations differ
+                // only by the chain rule.
+                // Derivatives at an extraordinary vertex depend on the parameterisation's
+                // degeneracy there; compare them inside the sub-patch.
+                if u > 0.0 && v > 0.0 && u + v < 1.0 {
+                    assert!(
+                        close(a.du * scale, b.du, 1e-8),
+                        "du patch {f} child {c} ({u},{v}): {:?} vs {:?}",
+                        a.du * scale,
+                        b.du
+                    );
+                    assert!(
+                        close(a.dv * scale, b.dv, 1e-8),
+                        "dv patch {f} child {c} ({u},{v})"
+                    );
+                    assert!(
+                        close(a.duu * 0.25, b.duu, 1e-7),
+                        "duu patch {f} child {c} ({u},{v})"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn refined_icosahedron_has_the_same_limit_surface() {
+    check_refinement_invariance(&jitter(&icosahedron(), 0.2, 1));
+}
+
+#[test]
+fn refined_octahedron_has_the_same_limit_surface() {
+    check_refinement_invariance(&jitter(&octahedron(), 0.2, 2));
+}
+
+#[test]
+fn refined_open_grid_has_the_same_limit_surface() {
+    check_refinement_invariance(&jitter(
+        &tri_grid(4, |x, y| (x * 0.7).sin() + 0.3 * y * y),
+        0.1,
+        3,
+    ));
+}
+
+#[test]
+fn limit_at_control_vertices_equals_limit_masks() {
+    for mesh in [
+        jitter(&icosahedron(), 0.2, 4),
+        jitter(&tri_grid(4, |x, y| x * y * 0.1), 0.1, 5),
+    ] {
+        let s = loop_surface(&mesh);
+        let limits = s.limit_positions();
+        for f in 0..mesh.num_faces() {
+            for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].iter().enumerate() {
+                let e = s.eval(SurfaceParam {
+                    patch: f as u32,
+                    u,
+                    v,
+                });
+                let vtx = mesh.face(f)[k] as usize;
+                assert!(close(e.point, limits[vtx], 1e-12), "face {f} corner {k}");
+            }
+        }
+    }
+}
+
+/// Regular patches are quartic box splines: compare the limit of a regular patch with the
+/// limit-mask positions of the twice-refined mesh at the matching dyadic parameters.
+#[test]
+fn regular_patch_matches_refined_limit_points() {
+    let mesh = jitter(
+        &tri_grid(6, |x, y| 0.2 * (x - 3.0).powi(2) - 0.1 * x * y),
+        0.05,
+        6,
+    );
+    let s0 = loop_surface(&mesh);
+    let s1 = refined(&mesh);
+    let limits = s1.limit_positions();
+    // Face 2 * (6 * 2 + 2) is an interior, regular patch. Its child corners are refined vertices.
+    let f = 2 * (6 * 2 + 2);
+    for c in 0..4u32 {
+        let child = 4 * f + c;
+        let corners = s1.control_mesh().face_vertices(child).collect::<Vec<_>>();
+        for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].iter().enumerate() {
+            let (pu, pv, _) = to_parent(c as usize, u, v);
+            let a = s0.eval(SurfaceParam {
+                patch: f,
+                u: pu,
+                v: pv,
+            });
+            assert!(close(a.point, limits[corners[k] as usize], 1e-12));
+        }
+    }
+}
+
+fn normal(e: &LimitEval) -> Vec3 {
+    e.du.cross(e.dv).normalize()
+}
+
+/// Positions and tangent planes agree across every shared edge (C1) to 1e-9.
+#[test]
+fn limit_surface_is_c1_across_patch_edges() {
+    for mesh in [
+        jitter(&icosahedron(), 0.2, 7),
+        jitter(&tri_grid(4, |x, y| (x + y).sin()), 0.1, 8),
+    ] {
+        let s = loop_surface(&mesh);
+        let cm = s.control_mesh();
+        for f in 0..cm.num_faces() as u32 {
+            for (k, h) in cm.face_half_edges(f).enumerate() {
+                let t = cm.twin(h);
+                if t == geofit::mesh::NONE {
+                    continue;
+                }
+                let g = cm.face_of(t);
+                let kt = cm.face_half_edges(g).position(|x| x == t).unwrap();
+                for i in 1..10 {
+                    let a = i as f64 / 10.0;
+                    let (u, v) = edge_param(k, a);
+                    let (ug, vg) = edge_param(kt, 1.0 - a);
+                    let ea = s.eval(SurfaceParam { patch: f, u, v });
+                    let eb = s.eval(SurfaceParam {
+                        patch: g,
+                        u: ug,
+                        v: vg,
+                    });
+                    assert!(
+                        close(ea.point, eb.point, 1e-9),
+                        "edge of face {f}: position"
+                    );
+                    assert!(
+                        (normal(&ea) - normal(&eb)).length() < 1e-9,
+                        "edge of face {f}: normal"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Parameters at fraction `a` along edge `k` of a triangle (from corner k to corner k+1).
+fn edge_param(k: usize, a: f64) -> (f64, f64) {
+    match k {
+        0 => (a, 0.0),
+        1 => (1.0 - a, a),
+        _ => (0.0, 1.0 - a),
+    }
+}
+
+#[test]
+fn open_boundary_limit_curve_is_the_cubic_bspline_of_the_boundary() {
+    let n = 6;
+    let mesh = tri_grid(n, |x, y| 0.1 * x * x - 0.05 * y);
+    let s = loop_surface(&mesh);
+    let p = |i: usize| mesh.positions()[i];
+    // Bottom row faces 2 * i have edge 0 from vertex i to i + 1 on the boundary.
+    for i in 1..n - 1 {
+        for k in 0..=8 {
+            let t = k as f64 / 8.0;
+            let e = s.eval(SurfaceParam {
+                patch: 2 * i as u32,
+                u: t,
+                v: 0.0,
+            });
+            let b = [
+                (1.0 - t).powi(3) / 6.0,
+                (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
+                (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+                t.powi(3) / 6.0,
+            ];
+            let c: Point3 = (0..4).map(|j| p(i + j - 1) * b[j]).sum();
+            assert!(
+                close(e.point, c, 1e-9),
+                "segment {i} t {t}: {:?} vs {c:?}",
+                e.point
+            );
+        }
+    }
+}
+
+#[test]
+fn derivatives_match_finite_differences() {
+    let mesh = jitter(&icosahedron(), 0.2, 9);
+    let s = loop_surface(&mesh);
+    let h = 1e-6;
+    for f in 0..mesh.num_faces() as u32 {
+        for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.2), (0.3, 0.6)] {
+            let e = s.eval(SurfaceParam { patch: f, u, v });
+            let at = |u: f64, v: f64| s.eval(SurfaceParam { patch: f, u, v });
+            let du = (at(u + h, v).point - at(u - h, v).point) / (2.0 * h);
+            let dv = (at(u, v + h).point - at(u, v - h).point) / (2.0 * h);
+            assert!(
+                close(du, e.du, 1e-6) && close(dv, e.dv, 1e-6),
+                "face {f} ({u},{v})"
+            );
+            let duu = (at(u + h, v).du - at(u - h, v).du) / (2.0 * h);
+            let duv = (at(u, v + h).du - at(u, v - h).du) / (2.0 * h);
+            assert!(
+                close(duu, e.duu, 1e-5) && close(duv, e.duv, 1e-5),
+                "face {f} ({u},{v}) second"
+            );
+        }
+    }
+}
+
+#[test]
+fn stencil_reproduces_eval() {
+    let mesh = jitter(&tri_grid(4, |x, y| (x * y).cos()), 0.1, 10);
+    let s = loop_surface(&mesh);
+    let mut st = Vec::new();
+    for f in 0..mesh.num_faces() as u32 {
+        for &(u, v) in &[(0.0, 0.0), (0.2, 0.3), (0.5, 0.0), (1e-9, 0.0)] {
+            st.clear();
+            s.stencil(SurfaceParam { patch: f, u, v }, &mut st);
+            let p: Point3 = st
+                .iter()
+                .map(|&(i, w)| mesh.positions()[i as usize] * w)
+                .sum();
+            let sum: f64 = st.iter().map(|&(_, w)| w).sum();
+            assert!((sum - 1.0).abs() < 1e-12);
+            assert!(
+                close(p, s.eval(SurfaceParam { patch: f, u, v }).point, 1e-12),
+                "face {f} ({u},{v})"
+            );
+        }
+    }
+}
