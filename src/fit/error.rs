@@ -33,4 +33,19 @@ pub enum FitError {
         /// Index of the point in the data.
         index: usize,
     },
+    /// A data point repeats the one before it, so the polyline has a zero-length segment.
+    #[error("data point {index} repeats the point before it")]
+    DuplicatePoint {
+        /// Index of the repeated point in the input.
+        index: usize,
+    },
+    /// The spline could not be built (degree out of range, bad knots).
+    #[error(transparent)]
+    Spline(#[from] crate::spline::SplineError),
+    /// A least-squares system has no unique solution: some control point has no data nearby.
+    #[error("the least-squares system is singular at control point {index}")]
+    Singular {
+        /// The control point without support.
+        index: usize,
+    },
 }

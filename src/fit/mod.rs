@@ -5,6 +5,7 @@
 
 mod accel;
 pub mod closest;
+pub mod curve;
 mod error;
 pub mod options;
 pub mod refine;
@@ -13,6 +14,7 @@ mod stats;
 pub mod subdiv;
 
 pub use closest::FootPoint;
+pub use curve::{CurveFitOptions, CurveFitter};
 pub use error::FitError;
 pub use options::{Acceleration, SubdivFitOptions, Weighting};
 pub use report::FitReport;

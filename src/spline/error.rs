@@ -48,7 +48,7 @@ pub enum SplineError {
     },
     /// A knot is repeated more often than continuity allows.
     #[error(
-        "knot {value} at index {index} has multiplicity {multiplicity} > degree + 1 = {limit}"
+        "knot {value} at index {index} has multiplicity {multiplicity}, more than the {limit} allowed"
     )]
     KnotMultiplicity {
         /// Index of the first copy.
@@ -57,7 +57,36 @@ pub enum SplineError {
         value: f64,
         /// How often it occurs.
         multiplicity: usize,
-        /// degree + 1.
+        /// The largest multiplicity allowed: degree + 1 (degree for a closed curve).
         limit: usize,
+    },
+    /// The number of control points (or weights) does not fit the knots and degree.
+    #[error("{found} control points given where {expected} are needed")]
+    ControlPointCount {
+        /// Control points (or weights) given.
+        found: usize,
+        /// Control points needed.
+        expected: usize,
+    },
+    /// A control point has a NaN or infinite coordinate.
+    #[error("control point {index} is not finite")]
+    NonFiniteControlPoint {
+        /// Index of the control point.
+        index: usize,
+    },
+    /// A NURBS weight is not a positive finite number.
+    #[error("weight {index} is {value}: weights must be positive and finite")]
+    BadWeight {
+        /// Index of the weight.
+        index: usize,
+        /// The weight.
+        value: f64,
+    },
+    /// A knot cannot be inserted: outside the domain, not finite, or already of full
+    /// multiplicity.
+    #[error("cannot insert knot {value}: outside the domain or already of multiplicity p")]
+    BadKnotInsertion {
+        /// The knot value.
+        value: f64,
     },
 }

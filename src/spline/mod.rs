@@ -2,9 +2,15 @@
 //!
 //! [`KnotVector`] holds a checked knot sequence with its degree and evaluates the B-spline basis
 //! and its derivatives (The NURBS Book, algorithms A2.1–A2.3); curves and surfaces build on it.
+//! [`BSplineCurve`] is an open or closed (periodic) B-spline or NURBS curve; [`ChaikinCurve`] is a
+//! corner-cutting curve evaluated exactly through its quadratic B-spline limit.
 
+mod chaikin;
+mod curve;
 mod error;
 mod knots;
 
+pub use chaikin::ChaikinCurve;
+pub use curve::{BSplineCurve, CurveBasis, CurveNearest, MAX_CURVE_DEGREE, MAX_DERIV};
 pub use error::SplineError;
-pub use knots::KnotVector;
+pub use knots::{KnotVector, MAX_DEGREE};

@@ -1,0 +1,579 @@
+//! Geometric B-spline curve fitting (SPEC §1.9): Douglas–Peucker initial control points,
+//! chord-length parameters, Newton foot points, error vectors spread over the p + 1 control
+//! points of the foot point's span by basis value and normalised per control point, with
+//! acceleration, damping and knot insertion where the error stays above tolerance.
+//!
+//! The data helpers here (validation, chord-length parameters, foot points) are shared with the
+//! least-squares knot-placement fitter in [`super::knot_placement`].
+
+use super::accel::Accelerator;
+use super::{Acceleration, ErrorStats, FitError, FitStatus, Fitter, IterationRecord, Tolerances};
+use crate::geom::{Aabb, Point3, Vec3};
+use crate::spline::{BSplineCurve, MAX_CURVE_DEGREE};
+use web_time::Instant;
+
+/// Options of the geometric curve fitter. Defaults in brackets on each field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct CurveFitOptions {
+    /// Degree of the curve, 1..=5 [3].
+    pub degree: usize,
+    /// Fit a closed (periodic) curve through the data in order, back to the first point [false].
+    pub closed: bool,
+    /// Stop when these are met [E_avg 0.01 %, E_max 0.05 %].
+    pub tolerances: Tolerances,
+    /// Iteration cap [300].
+    pub max_iter: usize,
+    /// Douglas–Peucker tolerance for the initial control points, % of the bbox diagonal [1.0].
+    pub simplify_pct: f64,
+    /// Largest number of control points knot insertion may reach [the number of data points].
+    pub max_control: Option<usize>,
+    /// Insert knots at the latest after this many iterations without meeting the tolerances [8].
+    pub refine_interval: usize,
+    /// Insert knots earlier when one iteration lowers E_max by less than this fraction [0.02].
+    pub stall_ratio: f64,
+    /// Acceleration of the iteration [Anderson, depth 5].
+    pub acceleration: Acceleration,
+    /// Newton iterations per foot point and fitting iteration [8].
+    pub newton_iter: usize,
+}
+
+impl Default for CurveFitOptions {
+    fn default() -> Self {
+        CurveFitOptions {
+            degree: 3,
+            closed: false,
+            tolerances: Tolerances::default(),
+            max_iter: 300,
+            simplify_pct: 1.0,
+            max_control: None,
+            refine_interval: 8,
+            stall_ratio: 0.02,
+            acceleration: Acceleration::default(),
+            newton_iter: 8,
+        }
+    }
+}
+
+impl CurveFitOptions {
+    /// Sets the degree.
+    pub fn with_degree(mut self, degree: usize) -> Self {
+        self.degree = degree;
+        self
+    }
+    /// Sets whether the curve is closed.
+    pub fn with_closed(mut self, closed: bool) -> Self {
+        self.closed = closed;
+        self
+    }
+    /// Sets the tolerances.
+    pub fn with_tolerances(mut self, tolerances: Tolerances) -> Self {
+        self.tolerances = tolerances;
+        self
+    }
+    /// Sets the iteration cap.
+    pub fn with_max_iter(mut self, max_iter: usize) -> Self {
+        self.max_iter = max_iter;
+        self
+    }
+    /// Sets the Douglas–Peucker tolerance, % of the bbox diagonal.
+    pub fn with_simplify_pct(mut self, pct: f64) -> Self {
+        self.simplify_pct = pct;
+        self
+    }
+    /// Sets the control-point budget of knot insertion.
+    pub fn with_max_control(mut self, max_control: Option<usize>) -> Self {
+        self.max_control = max_control;
+        self
+    }
+    /// Sets the acceleration.
+    pub fn with_acceleration(mut self, acceleration: Acceleration) -> Self {
+        self.acceleration = acceleration;
+        self
+    }
+
+    fn validate(&self) -> Result<(), FitError> {
+        let bad = |name, reason: String| Err(FitError::InvalidOption { name, reason });
+        if !(1..=MAX_CURVE_DEGREE).contains(&self.degree) {
+            return bad(
+                "degree",
+                format!("{} is not in 1..={MAX_CURVE_DEGREE}", self.degree),
+            );
+        }
+        if !(self.simplify_pct.is_finite() && self.simplify_pct > 0.0) {
+            return bad(
+                "simplify",
+                format!("{} must be positive", self.simplify_pct),
+            );
+        }
+        if self.refine_interval == 0 {
+            return bad("refine-interval", "must be at least 1".into());
+        }
+        check_tolerances(&self.tolerances)?;
+        match self.acceleration {
+            Acceleration::Relax { omega } if !(omega > 0.0 && omega < 2.0) => bad(
+                "accel",
+                format!("relaxation factor {omega} is not in (0, 2)"),
+            ),
+            Acceleration::Anderson { depth } if !(1..=20).contains(&depth) => {
+                bad("accel", format!("Anderson depth {depth} is not in 1..=20"))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// Rejects negative or non-finite tolerances.
+pub(crate) fn check_tolerances(t: &Tolerances) -> Result<(), FitError> {
+    for (name, v) in [
+        ("tol-avg", t.avg_pct),
+        ("tol-max", t.max_pct),
+        ("tol-rms", t.rms_pct),
+    ] {
+        if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+            return Err(FitError::InvalidOption {
+                name,
+                reason: format!("{v} is not a non-negative percentage"),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Ordered curve data with its chord-length parameters and scale.
+#[derive(Clone, Debug)]
+pub(crate) struct CurveData {
+    pub points: Vec<Point3>,
+    /// Chord-length parameters on [0, 1]; for a closed curve the closing segment counts and the
+    /// last point sits before 1.
+    pub chord: Vec<f64>,
+    pub diagonal: f64,
+    /// All points share one z: errors get a sign from the in-plane normal.
+    pub planar: bool,
+}
+
+impl CurveData {
+    /// Checks and parameterises `points`: at least `needed`, finite, no point equal to the one
+    /// before it. A closed polyline given with its first point repeated at the end loses the
+    /// repeat.
+    pub fn try_new(points: &[Point3], closed: bool, needed: usize) -> Result<CurveData, FitError> {
+        if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+            return Err(FitError::NonFinitePoint { index });
+        }
+        let mut points = points.to_vec();
+        if closed && points.len() > 1 && points.first() == points.last() {
+            points.pop();
+        }
+        if points.len() < needed {
+            return Err(FitError::TooFewPoints {
+                found: points.len(),
+                needed,
+            });
+        }
+        if let Some(i) = (1..points.len()).find(|&i| points[i] == points[i - 1]) {
+            return Err(FitError::DuplicatePoint { index: i });
+        }
+        let bbox = Aabb::from_points(&points).ok_or(FitError::TooFewPoints { found: 0, needed })?;
+        let mut chord = vec![0.0];
+        for w in points.windows(2) {
+            chord.push(chord[chord.len() - 1] + (w[1] - w[0]).length());
+        }
+        let total = chord[chord.len() - 1]
+            + if closed {
+                (points[0] - points[points.len() - 1]).length()
+            } else {
+                0.0
+            };
+        chord.iter_mut().for_each(|c| *c /= total);
+        Ok(CurveData {
+            planar: bbox.max.z == bbox.min.z,
+            diagonal: bbox.diagonal(),
+            points,
+            chord,
+        })
+    }
+
+    /// Foot points of every data point on `curve`, Newton from `params`; returns the distances
+    /// (signed for planar data: positive on the left of the direction of travel).
+    pub fn foot_points(
+        &self,
+        curve: &BSplineCurve,
+        params: &mut [f64],
+        newton_iter: usize,
+    ) -> Vec<f64> {
+        self.points
+            .iter()
+            .zip(params.iter_mut())
+            .map(|(&p, u)| {
+                let near = curve.closest_point_from(p, *u, newton_iter);
+                *u = near.u;
+                self.signed_distance(curve, p, &near)
+            })
+            .collect()
+    }
+
+    fn signed_distance(
+        &self,
+        curve: &BSplineCurve,
+        p: Point3,
+        near: &crate::spline::CurveNearest,
+    ) -> f64 {
+        let d = near.dist_sq.sqrt();
+        if !self.planar {
+            return d;
+        }
+        let tangent = curve.eval_derivs(near.u, 1)[1];
+        let normal = Vec3::new(-tangent.y, tangent.x, 0.0);
+        if (p - near.point).dot(normal) < 0.0 {
+            -d
+        } else {
+            d
+        }
+    }
+}
+
+/// Indices of the points Douglas–Peucker keeps between `first` and `last` (both kept) at
+/// distance tolerance `eps`. `at(i)` gives point i; iterative, so long inputs cannot overflow
+/// the stack.
+fn douglas_peucker(
+    at: &dyn Fn(usize) -> Point3,
+    first: usize,
+    last: usize,
+    eps: f64,
+) -> Vec<usize> {
+    let mut keep = vec![first, last];
+    let mut stack = vec![(first, last)];
+    while let Some((a, b)) = stack.pop() {
+        let (pa, pb) = (at(a), at(b));
+        let ab = pb - pa;
+        let len_sq = ab.length_squared();
+        let dist = |p: Point3| {
+            let ap = p - pa;
+            if len_sq == 0.0 {
+                ap.length()
+            } else {
+                (ap - ab * (ap.dot(ab) / len_sq).clamp(0.0, 1.0)).length()
+            }
+        };
+        let far = (a + 1..b)
+            .map(|i| (i, dist(at(i))))
+            .max_by(|x, y| x.1.total_cmp(&y.1));
+        if let Some((i, _)) = far.filter(|&(_, d)| d > eps) {
+            keep.push(i);
+            stack.push((a, i));
+            stack.push((i, b));
+        }
+    }
+    keep.sort_unstable();
+    keep.dedup();
+    keep
+}
+
+/// The data indices that become the initial control points: Douglas–Peucker at `eps`, topped
+/// up with evenly spread indices when that keeps fewer than `min` points. A closed polyline is
+/// split at the point farthest from the first one.
+pub(crate) fn initial_indices(data: &CurveData, closed: bool, eps: f64, min: usize) -> Vec<usize> {
+    let n = data.points.len();
+    let pts = &data.points;
+    let mut idx = if closed {
+        let far = (0..n)
+            .max_by(|&i, &j| {
+                let (di, dj) = ((pts[i] - pts[0]).length(), (pts[j] - pts[0]).length());
+                di.total_cmp(&dj)
+            })
+            .unwrap_or(0);
+        let at = |i: usize| pts[i % n];
+        let mut a = douglas_peucker(&at, 0, far.max(1), eps);
+        a.extend(douglas_peucker(&at, far.max(1), n, eps));
+        a.retain(|&i| i < n);
+        a
+    } else {
+        douglas_peucker(&|i| pts[i], 0, n - 1, eps)
+    };
+    if idx.len() < min {
+        let count = if closed { min } else { min - 1 };
+        idx.extend((0..count).map(|k| k * (n - usize::from(!closed)) / count));
+        if !closed {
+            idx.push(n - 1);
+        }
+    }
+    idx.sort_unstable();
+    idx.dedup();
+    idx
+}
+
+/// The initial curve on the data points `idx`: those points as control points, knots by
+/// averaging their chord-length parameters (The NURBS Book eq. 9.8), periodically for closed
+/// curves, so each control point's basis function peaks near its data point.
+pub(crate) fn initial_curve(
+    data: &CurveData,
+    idx: &[usize],
+    degree: usize,
+    closed: bool,
+) -> Result<BSplineCurve, FitError> {
+    let ctrl: Vec<Point3> = idx.iter().map(|&i| data.points[i]).collect();
+    let s: Vec<f64> = idx.iter().map(|&i| data.chord[i]).collect();
+    let n = ctrl.len();
+    let p = degree;
+    if closed {
+        // s extended periodically: s(k) = s[k mod n] + ⌊k / n⌋.
+        let se = |k: isize| {
+            let q = k.div_euclid(n as isize);
+            s[k.rem_euclid(n as isize) as usize] + q as f64
+        };
+        // Knot t_k sits so that the Greville abscissa of basis k − p + … lands on s.
+        let t = |k: isize| {
+            let c = k - (p as isize + 1) / 2;
+            if p % 2 == 1 {
+                se(c)
+            } else {
+                0.5 * (se(c - 1) + se(c))
+            }
+        };
+        let tau: Vec<f64> = (0..=n).map(|j| t((j + p) as isize)).collect();
+        Ok(BSplineCurve::try_periodic(p, &tau, ctrl)?)
+    } else {
+        let mut knots = vec![0.0; p + 1];
+        for j in 1..n - p {
+            knots.push(s[j..j + p].iter().sum::<f64>() / p as f64);
+        }
+        knots.extend(std::iter::repeat_n(1.0, p + 1));
+        Ok(BSplineCurve::try_new(p, knots, ctrl)?)
+    }
+}
+
+/// The geometric curve fitter (SPEC §1.9), driven through [`Fitter`].
+#[derive(Clone, Debug)]
+pub struct CurveFitter {
+    data: CurveData,
+    options: CurveFitOptions,
+    curve: BSplineCurve,
+    params: Vec<f64>,
+    errors: Vec<f64>,
+    stats: ErrorStats,
+    history: Vec<IterationRecord>,
+    accel: Accelerator,
+    since_refine: usize,
+    status: FitStatus,
+    initial_control: usize,
+}
+
+impl CurveFitter {
+    /// Sets up a fit of the ordered points `points` (a polyline; closed curves wrap from the
+    /// last point to the first): validates the input, builds the initial curve and its foot
+    /// points.
+    pub fn try_new(points: &[Point3], options: CurveFitOptions) -> Result<CurveFitter, FitError> {
+        options.validate()?;
+        let p = options.degree;
+        let data = CurveData::try_new(points, options.closed, p + 2)?;
+        let eps = options.simplify_pct / 100.0 * data.diagonal;
+        let idx = initial_indices(&data, options.closed, eps, p + 1);
+        let curve = initial_curve(&data, &idx, p, options.closed)?;
+        // Chord parameters wrap into a periodic domain that need not start at 0.
+        let mut params: Vec<f64> = data
+            .chord
+            .iter()
+            .map(|&c| curve.normalize_param(c))
+            .collect();
+        let errors = data.foot_points(&curve, &mut params, options.newton_iter);
+        let stats = ErrorStats::from_distances(&errors, data.diagonal);
+        let initial_control = curve.control_points().len();
+        let mut fitter = CurveFitter {
+            accel: Accelerator::new(options.acceleration),
+            data,
+            options,
+            curve,
+            params,
+            errors,
+            stats,
+            history: Vec::new(),
+            since_refine: 0,
+            status: FitStatus::Running,
+            initial_control,
+        };
+        if fitter.options.tolerances.met_by(&fitter.stats) {
+            fitter.status = FitStatus::Converged;
+        }
+        Ok(fitter)
+    }
+
+    /// The current curve.
+    pub fn curve(&self) -> &BSplineCurve {
+        &self.curve
+    }
+
+    /// The foot-point parameter of every data point.
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    /// The data points (a closing repeat of the first point removed).
+    pub fn data(&self) -> &[Point3] {
+        &self.data.points
+    }
+
+    /// Control points of the initial curve.
+    pub fn initial_control_points(&self) -> usize {
+        self.initial_control
+    }
+
+    /// Where the fit stands.
+    pub fn status(&self) -> FitStatus {
+        self.status
+    }
+
+    /// Per control point, the basis-weighted mean of the error vectors of the foot points in
+    /// its support: d_j = Σ N_j(u_i) e_i / Σ N_j(u_i).
+    fn moves(&self) -> Vec<Vec3> {
+        let n = self.curve.control_points().len();
+        let p = self.curve.degree();
+        let mut sum = vec![Vec3::ZERO; n];
+        let mut weight = vec![0.0; n];
+        for (&q, &u) in self.data.points.iter().zip(&self.params) {
+            let e = q - self.curve.eval(u);
+            let b = self.curve.basis(u);
+            for j in 0..=p {
+                let c = self.curve.ctrl_index(b.first + j);
+                sum[c] += b.values[j] * e;
+                weight[c] += b.values[j];
+            }
+        }
+        sum.iter()
+            .zip(&weight)
+            .map(|(s, &w)| if w > 0.0 { *s / w } else { Vec3::ZERO })
+            .collect()
+    }
+
+    /// Moves the control points to `ctrl` and recomputes foot points and statistics.
+    fn apply(&mut self, ctrl: &[Point3], params: &[f64]) {
+        self.curve.control_points_mut().copy_from_slice(ctrl);
+        self.params.copy_from_slice(params);
+        self.errors =
+            self.data
+                .foot_points(&self.curve, &mut self.params, self.options.newton_iter);
+        self.stats = ErrorStats::from_distances(&self.errors, self.data.diagonal);
+    }
+
+    /// One move of the control points, accelerated, undone and taken plain when it raised
+    /// E_rms.
+    fn iterate(&mut self) {
+        let x = self.curve.control_points().to_vec();
+        let params = self.params.clone();
+        let before = self.stats.e_rms;
+        let d = self.moves();
+        let proposal = self.accel.propose(&x, &d);
+        self.apply(&proposal, &params);
+        if self.stats.e_rms > before && self.options.acceleration != Acceleration::None {
+            self.accel.reset();
+            let plain: Vec<Point3> = x.iter().zip(&d).map(|(p, v)| *p + *v).collect();
+            self.apply(&plain, &params);
+        }
+    }
+
+    /// The absolute distance knot insertion aims below: the E_max tolerance, else E_rms, else
+    /// E_avg.
+    fn local_tolerance(&self) -> f64 {
+        let t = &self.options.tolerances;
+        let pct = t.max_pct.or(t.rms_pct).or(t.avg_pct).unwrap_or(0.0);
+        pct / 100.0 * self.data.diagonal
+    }
+
+    /// Inserts a knot at the middle of every span whose largest error exceeds the tolerance,
+    /// worst first, within the control-point budget. Returns whether any was inserted.
+    fn refine(&mut self) -> Result<bool, FitError> {
+        let tol = self.local_tolerance();
+        let knots = self.curve.knots().knots().to_vec();
+        let mut worst: Vec<(usize, f64)> = Vec::new();
+        for (&u, &e) in self.params.iter().zip(&self.errors) {
+            let span = self.curve.knots().find_span(u);
+            match worst.iter_mut().find(|(s, _)| *s == span) {
+                Some(w) => w.1 = w.1.max(e.abs()),
+                None => worst.push((span, e.abs())),
+            }
+        }
+        worst.retain(|&(_, e)| e > tol);
+        worst.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let budget = self
+            .options
+            .max_control
+            .unwrap_or(self.data.points.len())
+            .saturating_sub(self.curve.control_points().len());
+        worst.truncate(budget);
+        for &(span, _) in &worst {
+            let mid = 0.5 * (knots[span] + knots[span + 1]);
+            self.curve = self.curve.insert_knot(mid)?;
+        }
+        if !worst.is_empty() {
+            self.accel.reset();
+        }
+        Ok(!worst.is_empty())
+    }
+}
+
+impl Fitter for CurveFitter {
+    fn step(&mut self) -> Result<FitStatus, FitError> {
+        if self.status != FitStatus::Running {
+            return Ok(self.status);
+        }
+        let start = Instant::now();
+        let before = self.stats.e_max;
+        self.iterate();
+        self.since_refine += 1;
+        let met = self.options.tolerances.met_by(&self.stats);
+        let stalled = self.stats.e_max > before * (1.0 - self.options.stall_ratio);
+        let due = self.since_refine >= self.options.refine_interval
+            || (stalled && self.since_refine >= 2);
+        let refined = !met && due && self.refine()?;
+        if refined {
+            self.since_refine = 0;
+        }
+        let iter = self.history.len() + 1;
+        self.history.push(IterationRecord {
+            iter,
+            control_points: self.curve.control_points().len(),
+            e_avg_pct: self.stats.e_avg_pct,
+            e_max_pct: self.stats.e_max_pct,
+            e_rms_pct: self.stats.e_rms_pct,
+            ms: start.elapsed().as_secs_f64() * 1e3,
+            refined,
+        });
+        self.status = if met {
+            FitStatus::Converged
+        } else if iter >= self.options.max_iter {
+            FitStatus::MaxIterations
+        } else {
+            FitStatus::Running
+        };
+        Ok(self.status)
+    }
+
+    fn history(&self) -> &[IterationRecord] {
+        &self.history
+    }
+
+    fn point_errors(&self) -> &[f64] {
+        &self.errors
+    }
+
+    fn stats(&self) -> ErrorStats {
+        self.stats
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn douglas_peucker_keeps_corners() {
+        let pts = [
+            Point3::new(0.0, 0.0, 0.0),
+            Point3::new(1.0, 0.01, 0.0),
+            Point3::new(2.0, 0.0, 0.0),
+            Point3::new(2.0, 1.0, 0.0),
+            Point3::new(2.0, 2.0, 0.0),
+        ];
+        assert_eq!(douglas_peucker(&|i| pts[i], 0, 4, 0.1), vec![0, 2, 4]);
+        assert_eq!(douglas_peucker(&|i| pts[i], 0, 4, 0.001), vec![0, 1, 2, 4]);
+    }
+}
