@@ -109,11 +109,13 @@ fn grid(p: &Parsed, header: &Header) -> Result<Option<RangeGrid>, ReadError> {
 }
 
 /// Refuses an element count that the remaining bytes cannot hold, before anything is reserved:
-/// a ten-byte file that declares four billion vertices fails here at once.
+/// a ten-byte file that declares four billion vertices fails here at once. One byte of slack
+/// lets an ASCII file end without a final separator; a binary body one byte short still
+/// fails, at the exact offset, when the last value is read.
 fn check_room<B: Body>(body: &mut B, el: &Element) -> Result<(), ReadError> {
     let needed = el.count.saturating_mul(body.min_item_size(el));
     let remaining = body.remaining();
-    if needed <= remaining {
+    if needed.saturating_sub(1) <= remaining {
         return Ok(());
     }
     Err(ReadError::Truncated {
@@ -393,6 +395,20 @@ mod tests {
             e.to_string(),
             "PLY line 10: coordinate is not a finite number"
         );
+    }
+
+    #[test]
+    fn tightest_ascii_body_without_final_newline() {
+        let src = ascii(
+            "element vertex 2\nproperty float x\nproperty float y\n",
+            "1 2\n3 4",
+        );
+        assert_eq!(read(&src).unwrap().mesh.num_vertices(), 2);
+        let short = ascii(
+            "element vertex 2\nproperty float x\nproperty float y\n",
+            "1 2\n3",
+        );
+        assert!(matches!(read(&short), Err(ReadError::Truncated { .. })));
     }
 
     #[test]

@@ -35,7 +35,7 @@ pub fn write_obj(mesh: &PolyMesh, out: &mut impl Write) -> Result<(), WriteError
     let mut w = BufWriter::new(out);
     w.write_all(b"# written by geofit\n")?;
     for p in mesh.positions() {
-        writeln!(w, "v {} {} {}", p.x, p.y, p.z)?;
+        writeln!(w, "v {} {} {}", Decimal(p.x), Decimal(p.y), Decimal(p.z))?;
     }
     for f in mesh.faces() {
         w.write_all(b"f")?;
@@ -118,6 +118,22 @@ pub fn write_stl(mesh: &PolyMesh, out: &mut impl Write) -> Result<(), WriteError
     Ok(())
 }
 
+/// The shortest decimal that reads back as the same f64: plain for moderate magnitudes,
+/// scientific (`1e300`, `2.5e-7`) otherwise, where plain notation would run to hundreds of
+/// digits.
+struct Decimal(f64);
+
+impl std::fmt::Display for Decimal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a == 0.0 || (1e-5..1e16).contains(&a) {
+            write!(f, "{}", self.0)
+        } else {
+            write!(f, "{:e}", self.0)
+        }
+    }
+}
+
 /// `x` rounded to f32, or an error where it overflows to infinity.
 fn to_f32(x: f64) -> Result<f32, WriteError> {
     let y = x as f32;
@@ -126,7 +142,7 @@ fn to_f32(x: f64) -> Result<f32, WriteError> {
     } else {
         Err(WriteError::TooLarge {
             format: "STL",
-            what: format!("coordinate {x} exceeds the f32 range"),
+            what: format!("coordinate {x:e} exceeds the f32 range"),
         })
     }
 }

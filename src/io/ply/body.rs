@@ -105,13 +105,12 @@ impl Body for Ascii<'_> {
         Location::Line(self.line)
     }
 
-    /// Counts the end of the file as one more byte: it ends the last token as a separator
-    /// would, so that [`Ascii::min_item_size`] holds for the last item too.
     fn remaining(&self) -> usize {
-        self.bytes.len() - self.pos + 1
+        self.bytes.len() - self.pos
     }
 
-    /// Every property takes at least one character and one separator.
+    /// Every property takes at least one character and one separator (except the very last
+    /// one in the file, which the room check allows for).
     fn min_item_size(&self, el: &Element) -> usize {
         2 * el.props.len()
     }

@@ -191,7 +191,9 @@ fn parse_element<'a>(
     let (Some(name), Some(count)) = (toks.next(), toks.next()) else {
         return Err(error(line_no, "expected 'element NAME COUNT'".into()));
     };
-    let count = parse_i64(count)
+    let count = std::str::from_utf8(count)
+        .ok()
+        .and_then(|c| c.parse::<u64>().ok())
         .and_then(|c| usize::try_from(c).ok())
         .ok_or_else(|| error(line_no, format!("bad element count '{}'", show(count))))?;
     Ok(Element {
