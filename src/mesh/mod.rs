@@ -4,9 +4,11 @@
 mod error;
 mod halfedge;
 mod poly;
+pub mod simplify;
 mod validate;
 
 pub use error::MeshError;
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
+pub use simplify::{simplify, simplify_with, SimplifyError, SimplifyOptions};
 pub use validate::TopologyError;

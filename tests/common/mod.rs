@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod linear;
+pub mod manifold;
 pub mod meshes;
 
 use geofit::geom::Point3;

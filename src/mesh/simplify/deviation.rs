@@ -1,0 +1,257 @@
+//! How far a set of points lies from a triangle mesh: the measure of what simplification lost
+//! (the distance of every original vertex to the simplified surface).
+
+use crate::geom::{Aabb, Point3};
+use crate::mesh::PolyMesh;
+
+/// Distances of points to a mesh, in the mesh's units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Deviation {
+    /// Largest point-to-surface distance.
+    pub max: f64,
+    /// Root mean square of the distances.
+    pub rms: f64,
+    /// Mean distance.
+    pub mean: f64,
+}
+
+impl Deviation {
+    /// The same figures as percentages of `length` (usually the data's bounding-box diagonal).
+    pub fn percent_of(&self, length: f64) -> Deviation {
+        let s = if length > 0.0 { 100.0 / length } else { 0.0 };
+        Deviation {
+            max: self.max * s,
+            rms: self.rms * s,
+            mean: self.mean * s,
+        }
+    }
+}
+
+/// Distance from each of `points` to the triangles of `mesh` (polygons fan-triangulated), with
+/// max/rms/mean. Returns `None` when the mesh has no faces or there are no points.
+///
+/// A bounding-volume hierarchy over the triangles makes this about O(n log m).
+pub fn deviation(points: &[Point3], mesh: &PolyMesh) -> Option<Deviation> {
+    let tris: Vec<[Point3; 3]> = mesh
+        .triangles()
+        .iter()
+        .map(|t| t.map(|i| mesh.positions()[i as usize]))
+        .collect();
+    if tris.is_empty() || points.is_empty() {
+        return None;
+    }
+    let bvh = Bvh::build(&tris);
+    let (mut max, mut sum, mut sum_sq) = (0.0f64, 0.0, 0.0);
+    for &p in points {
+        let d = bvh.nearest_sq(&tris, p).sqrt();
+        max = max.max(d);
+        sum += d;
+        sum_sq += d * d;
+    }
+    let n = points.len() as f64;
+    Some(Deviation {
+        max,
+        rms: (sum_sq / n).sqrt(),
+        mean: sum / n,
+    })
+}
+
+/// Squared distance from `p` to triangle `t` (Ericson, Real-Time Collision Detection §5.1.5).
+pub(crate) fn point_triangle_dist_sq(p: Point3, t: &[Point3; 3]) -> f64 {
+    let [a, b, c] = *t;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length_squared();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length_squared();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (p - (a + ab * v)).length_squared();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length_squared();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (p - (a + ac * w)).length_squared();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (p - (b + (c - b) * w)).length_squared();
+    }
+    let denom = va + vb + vc;
+    if !(denom.abs() > 0.0) {
+        // Degenerate triangle: nearest of its edges' end points is a safe upper bound.
+        return ap.length_squared().min(bp.length_squared()).min(cp.length_squared());
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    (p - (a + ab * v + ac * w)).length_squared()
+}
+
+/// Squared distance from `p` to box `b` (0 inside).
+fn box_dist_sq(b: &Aabb, p: Point3) -> f64 {
+    let d = (b.min - p).max(p - b.max).max(Point3::ZERO);
+    d.length_squared()
+}
+
+/// A node: a box, and either two children or a range of triangles.
+struct Node {
+    bbox: Aabb,
+    /// Two children, or a leaf's range in [`Bvh::order`].
+    kind: NodeKind,
+}
+
+enum NodeKind {
+    /// Indices of the two child nodes.
+    Inner(u32, u32),
+    /// Start and end of the node's triangles in [`Bvh::order`].
+    Leaf(u32, u32),
+}
+
+/// Bounding-volume hierarchy over triangles, split at the median centroid on the longest axis.
+struct Bvh {
+    nodes: Vec<Node>,
+    /// Triangle indices, permuted so that every node's triangles are contiguous.
+    order: Vec<u32>,
+}
+
+const LEAF_SIZE: usize = 4;
+
+impl Bvh {
+    fn build(tris: &[[Point3; 3]]) -> Bvh {
+        let mut bvh = Bvh {
+            nodes: Vec::with_capacity(2 * tris.len() / LEAF_SIZE + 1),
+            order: (0..tris.len() as u32).collect(),
+        };
+        let centroids: Vec<Point3> = tris.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
+        bvh.build_node(tris, &centroids, 0, tris.len());
+        bvh
+    }
+
+    fn build_node(&mut self, tris: &[[Point3; 3]], cent: &[Point3], lo: usize, hi: usize) -> u32 {
+        let corners: Vec<Point3> = self.order[lo..hi]
+            .iter()
+            .flat_map(|&i| tris[i as usize])
+            .collect();
+        let bbox = Aabb::from_points(&corners).unwrap_or(Aabb {
+            min: Point3::ZERO,
+            max: Point3::ZERO,
+        });
+        let id = self.nodes.len() as u32;
+        self.nodes.push(Node {
+            bbox,
+            kind: NodeKind::Leaf(lo as u32, hi as u32),
+        });
+        if hi - lo > LEAF_SIZE {
+            let ext = bbox.max - bbox.min;
+            let axis = if ext.x >= ext.y && ext.x >= ext.z {
+                0
+            } else if ext.y >= ext.z {
+                1
+            } else {
+                2
+            };
+            let mid = (lo + hi) / 2;
+            self.order[lo..hi].select_nth_unstable_by(mid - lo, |&a, &b| {
+                cent[a as usize][axis]
+                    .total_cmp(&cent[b as usize][axis])
+                    .then(a.cmp(&b))
+            });
+            let left = self.build_node(tris, cent, lo, mid);
+            let right = self.build_node(tris, cent, mid, hi);
+            self.nodes[id as usize].kind = NodeKind::Inner(left, right);
+        }
+        id
+    }
+
+    fn nearest_sq(&self, tris: &[[Point3; 3]], p: Point3) -> f64 {
+        let mut best = f64::INFINITY;
+        let mut stack = vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if box_dist_sq(&node.bbox, p) >= best {
+                continue;
+            }
+            match node.kind {
+                NodeKind::Leaf(lo, hi) => {
+                    for &t in &self.order[lo as usize..hi as usize] {
+                        best = best.min(point_triangle_dist_sq(p, &tris[t as usize]));
+                    }
+                }
+                NodeKind::Inner(l, r) => {
+                    let dl = box_dist_sq(&self.nodes[l as usize].bbox, p);
+                    let dr = box_dist_sq(&self.nodes[r as usize].bbox, p);
+                    // Visit the nearer child first: push it last.
+                    if dl < dr {
+                        stack.extend([r, l]);
+                    } else {
+                        stack.extend([l, r]);
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_distance_regions() {
+        let t = [Point3::ZERO, Point3::X, Point3::Y];
+        let d = |x, y, z| point_triangle_dist_sq(Point3::new(x, y, z), &t);
+        assert!((d(0.2, 0.2, 2.0) - 4.0).abs() < 1e-12); // face
+        assert!((d(-1.0, -1.0, 0.0) - 2.0).abs() < 1e-12); // vertex a
+        assert!((d(0.5, -1.0, 0.0) - 1.0).abs() < 1e-12); // edge ab
+        assert!((d(1.0, 1.0, 0.0) - 0.5).abs() < 1e-12); // edge bc
+        assert!((d(3.0, 0.0, 0.0) - 4.0).abs() < 1e-12); // vertex b
+    }
+
+    #[test]
+    fn bvh_agrees_with_brute_force() {
+        let mut pos = Vec::new();
+        let mut faces = Vec::new();
+        let n = 12u32;
+        for j in 0..n {
+            for i in 0..n {
+                let (x, y) = (i as f64, j as f64);
+                pos.push(Point3::new(x, y, (x * 0.7).sin() + (y * 0.3).cos()));
+            }
+        }
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = j * n + i;
+                faces.push([a, a + 1, a + n + 1]);
+                faces.push([a, a + n + 1, a + n]);
+            }
+        }
+        let mesh = PolyMesh::try_new(pos, faces).expect("valid grid");
+        let tris: Vec<[Point3; 3]> = mesh
+            .triangles()
+            .iter()
+            .map(|t| t.map(|i| mesh.positions()[i as usize]))
+            .collect();
+        let bvh = Bvh::build(&tris);
+        for k in 0..200 {
+            let k = k as f64;
+            let p = Point3::new((k * 0.37) % 13.0 - 1.0, (k * 0.73) % 13.0 - 1.0, (k * 0.11) % 4.0 - 2.0);
+            let brute = tris
+                .iter()
+                .map(|t| point_triangle_dist_sq(p, t))
+                .fold(f64::INFINITY, f64::min);
+            assert!((bvh.nearest_sq(&tris, p) - brute).abs() < 1e-12);
+        }
+    }
+}

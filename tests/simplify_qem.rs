@@ -1,0 +1,275 @@
+//! QEM simplification: exact counts, manifold output, unchanged topology, no fold-overs, kept
+//! boundaries, determinism, accuracy on the bunny, and typed errors for bad input.
+
+mod common;
+
+use common::manifold::{assert_manifold, boundary_edges, boundary_loops, euler_characteristic};
+use geofit::geom::{Point3, Vec3};
+use geofit::mesh::simplify::deviation;
+use geofit::mesh::{simplify, simplify_with, PolyMesh, SimplifyError, SimplifyOptions};
+use std::collections::BTreeMap;
+
+/// Minimal OBJ reading (v and f lines) for the shared scans.
+fn load_obj(name: &str) -> PolyMesh {
+    let path = common::data_file(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path:?}: {e}"));
+    let mut pos = Vec::new();
+    let mut faces = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).map(|s| s.parse().expect("coordinate")).collect();
+                pos.push(Point3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => faces.push(
+                it.map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                    .collect::<Vec<u32>>(),
+            ),
+            _ => {}
+        }
+    }
+    PolyMesh::try_new(pos, faces).expect("valid OBJ")
+}
+
+/// An n×n grid of a wavy unit square whose outline is flat (one boundary loop, χ = 1).
+fn wavy_grid(n: u32) -> PolyMesh {
+    let pos = (0..n * n)
+        .map(|k| {
+            let (x, y) = ((k % n) as f64 / (n - 1) as f64, (k / n) as f64 / (n - 1) as f64);
+            let bump = (std::f64::consts::PI * x).sin() * (std::f64::consts::PI * y).sin();
+            Point3::new(x, y, 0.3 * bump * (3.0 * x).cos())
+        })
+        .collect();
+    let mut faces = Vec::new();
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i;
+            faces.push([a, a + 1, a + n + 1]);
+            faces.push([a, a + n + 1, a + n]);
+        }
+    }
+    PolyMesh::try_new(pos, faces).unwrap()
+}
+
+/// A torus as an n×m quad grid wrapped both ways (closed, χ = 0), faces as quads.
+fn torus(n: u32, m: u32) -> PolyMesh {
+    let mut pos = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            let (u, v) = (
+                i as f64 / n as f64 * std::f64::consts::TAU,
+                j as f64 / m as f64 * std::f64::consts::TAU,
+            );
+            let r = 1.0 + 0.35 * v.cos();
+            pos.push(Point3::new(r * u.cos(), r * u.sin(), 0.35 * v.sin()));
+        }
+    }
+    let id = |i: u32, j: u32| (j % m) * n + (i % n);
+    let mut faces = Vec::new();
+    for j in 0..m {
+        for i in 0..n {
+            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    PolyMesh::try_new(pos, faces).unwrap()
+}
+
+/// Asserts that no face of `coarse` points against the original surface it covers: the
+/// area-weighted normal of the original faces (every `stride`-th) whose centroids lie closest
+/// to it. A folded face points backwards (−1); faces bridging a groove or cutting a sharp
+/// corner may lie sideways (near 0), so the bound is −0.5.
+fn assert_no_foldover(original: &PolyMesh, coarse: &PolyMesh, stride: usize) {
+    let cp = coarse.positions();
+    let coarse_tris: Vec<[Point3; 3]> =
+        coarse.triangles().iter().map(|t| t.map(|i| cp[i as usize])).collect();
+    let mut covered = vec![Vec3::ZERO; coarse_tris.len()];
+    let op = original.positions();
+    for t in original.triangles().into_iter().step_by(stride) {
+        let [a, b, c] = t.map(|i| op[i as usize]);
+        let centroid = (a + b + c) / 3.0;
+        let nearest = (0..coarse_tris.len())
+            .min_by(|&i, &j| {
+                triangle_distance(centroid, &coarse_tris[i])
+                    .total_cmp(&triangle_distance(centroid, &coarse_tris[j]))
+            })
+            .unwrap();
+        covered[nearest] += (b - a).cross(c - a);
+    }
+    for (k, t) in coarse_tris.iter().enumerate() {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        let dot = n.dot(covered[k].normalize_or_zero());
+        assert!(dot > -0.5, "face {k} is folded over: {dot} against the surface it covers");
+    }
+}
+
+/// Distance from `p` to triangle `t`.
+fn triangle_distance(p: Point3, t: &[Point3; 3]) -> f64 {
+    let single = PolyMesh::try_new(t.to_vec(), [[0u32, 1, 2]]).unwrap();
+    deviation(&[p], &single).unwrap().max
+}
+
+/// Distance from `p` to the segment a–b.
+fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
+    let d = b - a;
+    let t = ((p - a).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    p.distance(a + d * t)
+}
+
+/// Largest distance from an original boundary vertex to the simplified boundary.
+fn boundary_drift(original: &PolyMesh, coarse: &PolyMesh) -> f64 {
+    let segs: Vec<(Point3, Point3)> = boundary_edges(coarse)
+        .into_iter()
+        .map(|(a, b)| (coarse.positions()[a as usize], coarse.positions()[b as usize]))
+        .collect();
+    boundary_edges(original)
+        .into_iter()
+        .map(|(a, _)| {
+            let p = original.positions()[a as usize];
+            segs.iter()
+                .map(|&(s, t)| segment_distance(p, s, t))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn grid_keeps_its_disc_topology_and_boundary() {
+    let grid = wavy_grid(30);
+    for target in [300, 60, 12] {
+        let coarse = simplify(&grid, target).unwrap();
+        assert_eq!(coarse.num_vertices(), target);
+        assert_manifold(&coarse);
+        assert_eq!(euler_characteristic(&coarse), 1);
+        assert_eq!(boundary_loops(&coarse), 1);
+        assert_no_foldover(&grid, &coarse, 1);
+    }
+    // The outline (a flat unit square) survives: its corners and sides stay in place.
+    let coarse = simplify(&grid, 60).unwrap();
+    assert!(boundary_drift(&grid, &coarse) < 1e-9, "{}", boundary_drift(&grid, &coarse));
+}
+
+#[test]
+fn closed_torus_stays_a_closed_torus() {
+    let torus = torus(40, 16);
+    let coarse = simplify(&torus, 100).unwrap();
+    assert_eq!(coarse.num_vertices(), 100);
+    assert_manifold(&coarse);
+    assert_eq!(euler_characteristic(&coarse), 0);
+    assert_eq!(boundary_loops(&coarse), 0);
+    assert_no_foldover(&torus, &coarse, 1);
+    let dev = deviation(torus.positions(), &coarse).unwrap();
+    assert!(dev.max < 0.05, "{dev:?}");
+}
+
+#[test]
+fn output_is_deterministic() {
+    let torus = torus(30, 12);
+    let a = simplify(&torus, 50).unwrap();
+    let b = simplify(&torus, 50).unwrap();
+    assert_eq!(a, b);
+}
+
+#[test]
+fn bunny_to_612_is_manifold_accurate_and_keeps_its_five_holes() {
+    let bunny = load_obj("stanford-bunny.obj");
+    let coarse = simplify(&bunny, 612).unwrap();
+    assert_eq!(coarse.num_vertices(), 612);
+    assert_manifold(&coarse);
+    assert_eq!(euler_characteristic(&coarse), euler_characteristic(&bunny));
+    assert_eq!(boundary_loops(&coarse), boundary_loops(&bunny));
+    assert_eq!(boundary_loops(&bunny), 5);
+    assert_no_foldover(&bunny, &coarse, 5);
+    let diag = bunny.bbox().unwrap().diagonal();
+    // MeshLab's QEM gives max 0.76 %, rms 0.157 % of the diagonal (SPEC §5).
+    let dev = deviation(bunny.positions(), &coarse).unwrap().percent_of(diag);
+    println!("bunny -> 612: {dev:?}");
+    assert!(dev.max <= 0.76 && dev.rms <= 0.157, "{dev:?}");
+    assert!(boundary_drift(&bunny, &coarse) < 0.01 * diag);
+}
+
+#[test]
+fn bad_input_gives_typed_errors() {
+    let grid = wavy_grid(5);
+    assert_eq!(
+        simplify(&PolyMesh::default(), 4),
+        Err(SimplifyError::NoFaces)
+    );
+    let cloud = PolyMesh::from_points(grid.positions().to_vec()).unwrap();
+    assert_eq!(simplify(&cloud, 4), Err(SimplifyError::NoFaces));
+    assert_eq!(
+        simplify(&grid, 3),
+        Err(SimplifyError::TargetTooSmall { target: 3, min: 4 })
+    );
+    assert_eq!(
+        simplify(&grid, 26),
+        Err(SimplifyError::TargetTooLarge {
+            target: 26,
+            available: 25
+        })
+    );
+    // A lone triangle has too few vertices for any target.
+    let tri = PolyMesh::try_new(vec![Point3::ZERO, Point3::X, Point3::Y], [[0, 1, 2]]).unwrap();
+    assert!(matches!(
+        simplify(&tri, 4),
+        Err(SimplifyError::TargetTooLarge { available: 3, .. })
+    ));
+    let bad = SimplifyOptions::default().with_max_normal_change_deg(f64::NAN);
+    assert!(matches!(
+        simplify_with(&grid, 10, &bad),
+        Err(SimplifyError::InvalidOption {
+            name: "max_normal_change_deg",
+            ..
+        })
+    ));
+    let bad = SimplifyOptions::default().with_boundary_weight(-1.0);
+    assert!(matches!(
+        simplify_with(&grid, 10, &bad),
+        Err(SimplifyError::InvalidOption {
+            name: "boundary_weight",
+            ..
+        })
+    ));
+}
+
+#[test]
+fn minimal_components_make_the_target_unreachable() {
+    // Two separate tetrahedra: neither can lose a vertex and stay a closed surface.
+    let mut pos = Vec::new();
+    let mut faces = Vec::new();
+    for k in 0..2 {
+        let o = Point3::new(3.0 * k as f64, 0.0, 0.0);
+        let b = 4 * k;
+        pos.extend([o, o + Vec3::X, o + Vec3::Y, o + Vec3::Z]);
+        faces.extend([[b, b + 2, b + 1], [b, b + 1, b + 3], [b, b + 3, b + 2], [b + 1, b + 2, b + 3]]);
+    }
+    let two = PolyMesh::try_new(pos, faces).unwrap();
+    assert_eq!(
+        simplify(&two, 4),
+        Err(SimplifyError::TargetUnreachable {
+            target: 4,
+            reached: 8
+        })
+    );
+    assert_eq!(simplify(&two, 8).unwrap().num_triangles(), 8);
+}
+
+#[test]
+fn unreferenced_vertices_duplicate_and_degenerate_faces_are_dropped() {
+    let grid = wavy_grid(6);
+    let mut pos = grid.positions().to_vec();
+    pos.push(Point3::new(5.0, 5.0, 5.0)); // in no face
+    let mut faces: Vec<Vec<u32>> = grid.faces().map(|f| f.to_vec()).collect();
+    faces.push(faces[0].clone()); // duplicate
+    faces.push(vec![0, 0, 1]); // degenerate
+    let messy = PolyMesh::try_new(pos, faces).unwrap();
+    let coarse = simplify(&messy, 20).unwrap();
+    assert_eq!(coarse.num_vertices(), 20);
+    assert_manifold(&coarse);
+    let by_pos: BTreeMap<[u64; 3], ()> = coarse
+        .positions()
+        .iter()
+        .map(|p| (p.to_array().map(f64::to_bits), ()))
+        .collect();
+    assert!(!by_pos.contains_key(&[5.0f64, 5.0, 5.0].map(f64::to_bits)));
+}
