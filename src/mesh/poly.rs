@@ -77,7 +77,7 @@ impl PolyMesh {
 
     /// Number of faces (polygons of any size).
     pub fn num_faces(&self) -> usize {
-        self.face_starts.len() - 1
+        self.face_starts.len().saturating_sub(1)
     }
 
     /// The vertex indices of face `i`. Panics if `i >= num_faces()` (a caller bug, not bad data).

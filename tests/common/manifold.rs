@@ -11,10 +11,16 @@ pub fn assert_manifold(mesh: &PolyMesh) {
     let mut directed = BTreeSet::new();
     let mut undirected: BTreeMap<(u32, u32), usize> = BTreeMap::new();
     for t in &tris {
-        assert!(t[0] != t[1] && t[1] != t[2] && t[0] != t[2], "degenerate face {t:?}");
+        assert!(
+            t[0] != t[1] && t[1] != t[2] && t[0] != t[2],
+            "degenerate face {t:?}"
+        );
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
-            assert!(directed.insert((a, b)), "directed edge {a}->{b} twice: orientation");
+            assert!(
+                directed.insert((a, b)),
+                "directed edge {a}->{b} twice: orientation"
+            );
             *undirected.entry((a.min(b), a.max(b))).or_default() += 1;
         }
     }
@@ -44,7 +50,11 @@ fn assert_link_is_disc(v: u32, link: &[(u32, u32)]) {
         .map(|e| e.0)
         .filter(|a| !link.iter().any(|e| e.1 == *a))
         .collect();
-    assert!(starts.len() <= 1, "vertex {v}: link has {} pieces", starts.len());
+    assert!(
+        starts.len() <= 1,
+        "vertex {v}: link has {} pieces",
+        starts.len()
+    );
     let start = starts.first().copied().unwrap_or(link[0].0);
     let mut seen = 1;
     let mut cur = start;
@@ -56,7 +66,11 @@ fn assert_link_is_disc(v: u32, link: &[(u32, u32)]) {
         seen += 1;
         assert!(seen <= link.len() + 1, "vertex {v}: link loops");
     }
-    let expected = if starts.is_empty() { link.len() } else { link.len() + 1 };
+    let expected = if starts.is_empty() {
+        link.len()
+    } else {
+        link.len() + 1
+    };
     assert_eq!(seen, expected, "vertex {v}: link is not one cycle or path");
 }
 

@@ -124,7 +124,11 @@ impl Work {
             return false;
         }
         let surviving = self.vfaces[u as usize].len() + self.vfaces[v as usize].len() - 2 * k;
-        if surviving == 0 || opposite[..k].iter().any(|&x| self.vfaces[x as usize].len() < 2) {
+        if surviving == 0
+            || opposite[..k]
+                .iter()
+                .any(|&x| self.vfaces[x as usize].len() < 2)
+        {
             return false;
         }
         let (mut nu, mut nv) = (
@@ -271,7 +275,11 @@ mod tests {
         assert_eq!(w.live, 8);
         assert_eq!(w.tri_alive.iter().filter(|&&a| a).count(), before - 2);
         assert!(w.vfaces[5].is_empty());
-        assert!(w.tris.iter().zip(&w.tri_alive).all(|(t, &a)| !a || !t.contains(&5)));
+        assert!(w
+            .tris
+            .iter()
+            .zip(&w.tri_alive)
+            .all(|(t, &a)| !a || !t.contains(&5)));
     }
 
     #[test]

@@ -90,9 +90,12 @@ pub(crate) fn point_triangle_dist_sq(p: Point3, t: &[Point3; 3]) -> f64 {
         return (p - (b + (c - b) * w)).length_squared();
     }
     let denom = va + vb + vc;
-    if !(denom.abs() > 0.0) {
+    if denom == 0.0 || denom.is_nan() {
         // Degenerate triangle: nearest of its edges' end points is a safe upper bound.
-        return ap.length_squared().min(bp.length_squared()).min(cp.length_squared());
+        return ap
+            .length_squared()
+            .min(bp.length_squared())
+            .min(cp.length_squared());
     }
     let (v, w) = (vb / denom, vc / denom);
     (p - (a + ab * v + ac * w)).length_squared()
@@ -246,7 +249,11 @@ mod tests {
         let bvh = Bvh::build(&tris);
         for k in 0..200 {
             let k = k as f64;
-            let p = Point3::new((k * 0.37) % 13.0 - 1.0, (k * 0.73) % 13.0 - 1.0, (k * 0.11) % 4.0 - 2.0);
+            let p = Point3::new(
+                (k * 0.37) % 13.0 - 1.0,
+                (k * 0.73) % 13.0 - 1.0,
+                (k * 0.11) % 4.0 - 2.0,
+            );
             let brute = tris
                 .iter()
                 .map(|t| point_triangle_dist_sq(p, t))

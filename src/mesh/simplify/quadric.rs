@@ -62,7 +62,7 @@ impl Quadric {
             .sum::<f64>()
             + 2.0 * (self.a01 * self.a01 + self.a02 * self.a02 + self.a12 * self.a12);
         let scale = norm_sq * norm_sq.sqrt();
-        if !(det.abs() > SINGULAR_RATIO * scale) {
+        if det.is_nan() || det.abs() <= SINGULAR_RATIO * scale {
             return None;
         }
         let x = a.inverse() * (-self.b);
@@ -76,7 +76,7 @@ impl Quadric {
         // Q(p + t d) = t² dᵀAd + 2t (dᵀAp + bᵀd) + const.
         let curv = d.dot(a * d);
         let slope = d.dot(a * p) + self.b.dot(d);
-        if !(curv > 0.0) {
+        if curv.is_nan() || curv <= 0.0 {
             return p;
         }
         let t = (-slope / curv).clamp(0.0, 1.0);
