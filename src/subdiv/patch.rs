@@ -281,9 +281,11 @@ fn unfold(topo: &Topo, scheme: Scheme) -> Option<Vec<Option<(i32, i32)>>> {
     Some(coords)
 }
 
-/// Whether a corner allows a closed-form patch: smooth with the regular valence, or on a
-/// straight crease/boundary (two sharp edges, two faces on the patch's side) or at a grid
-/// corner (two sharp edges, the patch alone between them) — the last two for quads only.
+/// Whether a corner allows a closed-form patch: smooth with the regular valence, or (quads
+/// only) on a straight crease or boundary: two sharp edges with two faces on the patch's side,
+/// where reflected phantom points reproduce the cubic B-spline crease rule exactly. A grid
+/// corner (one face between its sharp edges) is not regular: the crease rule smooths it, while
+/// reflected phantoms would make it interpolate the control vertex.
 fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
     if !topo.is_complete(c) {
         return false;
@@ -298,7 +300,7 @@ fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
         }
         2 if n == 4 => {
             topo.fan(c, 0, true, &mut fan);
-            (fan.len() == 1 || fan.len() == 2) && fan.iter().all(|&g| topo.face(g).len() == 4)
+            fan.len() == 2 && fan.iter().all(|&g| topo.face(g).len() == 4)
         }
         _ => false,
     }

@@ -1,0 +1,268 @@
+//! Catmull–Clark: exact limit evaluation (bicubic patches, phantom points at boundaries,
+//! local subdivision at extraordinary vertices), checked against refinement and closed forms.
+
+mod common;
+
+use common::meshes::{cube, jitter, quad_grid};
+use geofit::geom::{Point3, Vec3};
+use geofit::mesh::{ControlMesh, PolyMesh};
+use geofit::subdiv::{
+    quadrangulate, refine, CatmullClarkSurface, LimitEval, LimitSurface, Scheme, SurfaceParam,
+};
+
+fn surface(mesh: &PolyMesh) -> CatmullClarkSurface {
+    let cm = ControlMesh::try_new(mesh).unwrap();
+    let cm = if cm.is_quad_mesh() {
+        cm
+    } else {
+        quadrangulate(&cm).unwrap()
+    };
+    CatmullClarkSurface::from_control_mesh(cm).unwrap()
+}
+
+/// Parent parameters of child `c` of a quad (children start at corner c; see `refine`).
+fn to_parent(c: usize, u: f64, v: f64) -> (f64, f64) {
+    match c {
+        0 => (u / 2.0, v / 2.0),
+        1 => (1.0 - v / 2.0, u / 2.0),
+        2 => (1.0 - u / 2.0, 1.0 - v / 2.0),
+        _ => (v / 2.0, 1.0 - u / 2.0),
+    }
+}
+
+fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
+    (a - b).length() <= tol * (1.0 + a.length().max(b.length()))
+}
+
+fn normal(e: &LimitEval) -> Vec3 {
+    e.du.cross(e.dv).normalize()
+}
+
+fn spot_quads() -> PolyMesh {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/subdiv/spot_quads.obj");
+    geofit::io::read_path(&path).unwrap().mesh
+}
+
+fn check_refinement_invariance(mesh: &PolyMesh) {
+    let s0 = surface(mesh);
+    let s1 = CatmullClarkSurface::from_control_mesh(
+        refine(Scheme::CatmullClark, s0.control_mesh()).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(s1.num_patches(), 4 * s0.num_patches());
+    let samples = [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (0.5, 0.5),
+        (0.25, 0.75),
+        (1e-8, 3e-8),
+        (0.9, 0.1),
+        (0.0, 0.6),
+    ];
+    for f in 0..s0.num_patches() as u32 {
+        for c in 0..4 {
+            for &(u, v) in &samples {
+                let (pu, pv) = to_parent(c, u, v);
+                let a = s0.eval(SurfaceParam {
+                    patch: f,
+                    u: pu,
+                    v: pv,
+                });
+                let b = s1.eval(SurfaceParam {
+                    patch: 4 * f + c as u32,
+                    u,
+                    v,
+                });
+                assert!(
+                    close(a.point, b.point, 1e-10),
+                    "patch {f} child {c} ({u},{v}): {:?} vs {:?}",
+                    a.point,
+                    b.point
+                );
+                if u > 0.0 && v > 0.0 {
+                    assert!(
+                        (normal(&a) - normal(&b)).length() < 1e-8,
+                        "normal patch {f} child {c} ({u},{v})"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn refined_cube_has_the_same_limit_surface() {
+    check_refinement_invariance(&jitter(&cube(), 0.1, 1));
+}
+
+#[test]
+fn refined_open_grid_has_the_same_limit_surface() {
+    check_refinement_invariance(&jitter(
+        &quad_grid(4, |x, y| 0.3 * (x * 0.8).sin() * y),
+        0.1,
+        2,
+    ));
+}
+
+#[test]
+fn refined_quad_dominant_spot_has_the_same_limit_surface() {
+    check_refinement_invariance(&spot_quads());
+}
+
+#[test]
+fn limit_at_control_vertices_equals_limit_masks() {
+    for mesh in [
+        jitter(&cube(), 0.1, 3),
+        jitter(&quad_grid(3, |x, y| x * y * 0.1), 0.1, 4),
+    ] {
+        let s = surface(&mesh);
+        let limits = s.limit_positions();
+        for f in 0..mesh.num_faces() {
+            for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+                .iter()
+                .enumerate()
+            {
+                let e = s.eval(SurfaceParam {
+                    patch: f as u32,
+                    u,
+                    v,
+                });
+                assert!(
+                    close(e.point, limits[mesh.face(f)[k] as usize], 1e-12),
+                    "face {f} corner {k}"
+                );
+            }
+        }
+    }
+}
+
+fn bspline(t: f64) -> [f64; 4] {
+    [
+        (1.0 - t).powi(3) / 6.0,
+        (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
+        (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+        t.powi(3) / 6.0,
+    ]
+}
+
+/// Interior patches of a quad grid are uniform bicubic B-spline patches.
+#[test]
+fn regular_patch_is_the_bicubic_bspline() {
+    let n = 5;
+    let mesh = jitter(&quad_grid(n, |x, y| 0.2 * x * x - 0.1 * x * y), 0.1, 5);
+    let s = surface(&mesh);
+    let p = |i: usize, j: usize| mesh.positions()[j * (n + 1) + i];
+    let (i0, j0) = (2, 2);
+    for &(u, v) in &[(0.0, 0.0), (0.3, 0.7), (1.0, 0.5), (0.5, 0.5)] {
+        let (bu, bv) = (bspline(u), bspline(v));
+        let mut q = Point3::ZERO;
+        for b in 0..4 {
+            for a in 0..4 {
+                q += p(i0 + a - 1, j0 + b - 1) * (bu[a] * bv[b]);
+            }
+        }
+        let e = s.eval(SurfaceParam {
+            patch: (j0 * n + i0) as u32,
+            u,
+            v,
+        });
+        assert!(close(e.point, q, 1e-13), "({u},{v})");
+    }
+}
+
+#[test]
+fn open_boundary_limit_curve_is_the_cubic_bspline_of_the_boundary() {
+    let n = 5;
+    let mesh = quad_grid(n, |x, y| 0.1 * x * x - 0.05 * y);
+    let s = surface(&mesh);
+    let p = |i: usize| mesh.positions()[i];
+    for i in 1..n - 1 {
+        for k in 0..=8 {
+            let t = k as f64 / 8.0;
+            let e = s.eval(SurfaceParam {
+                patch: i as u32,
+                u: t,
+                v: 0.0,
+            });
+            let b = bspline(t);
+            let c: Point3 = (0..4).map(|j| p(i + j - 1) * b[j]).sum();
+            assert!(
+                close(e.point, c, 1e-12),
+                "segment {i} t {t}: {:?} vs {c:?}",
+                e.point
+            );
+        }
+    }
+}
+
+#[test]
+fn limit_surface_is_c1_across_patch_edges() {
+    for mesh in [jitter(&cube(), 0.1, 6), spot_quads()] {
+        let s = surface(&mesh);
+        let cm = s.control_mesh();
+        for f in 0..cm.num_faces() as u32 {
+            for (k, h) in cm.face_half_edges(f).enumerate() {
+                let t = cm.twin(h);
+                if t == geofit::mesh::NONE {
+                    continue;
+                }
+                let g = cm.face_of(t);
+                let kt = cm.face_half_edges(g).position(|x| x == t).unwrap();
+                for i in 1..8 {
+                    let a = i as f64 / 8.0;
+                    let (u, v) = edge_param(k, a);
+                    let (ug, vg) = edge_param(kt, 1.0 - a);
+                    let ea = s.eval(SurfaceParam { patch: f, u, v });
+                    let eb = s.eval(SurfaceParam {
+                        patch: g,
+                        u: ug,
+                        v: vg,
+                    });
+                    assert!(
+                        close(ea.point, eb.point, 1e-9),
+                        "edge of face {f}: position"
+                    );
+                    assert!(
+                        (normal(&ea) - normal(&eb)).length() < 1e-9,
+                        "edge of face {f}: normal"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Parameters at fraction `a` along side `k` of the unit square (from corner k to corner k+1).
+fn edge_param(k: usize, a: f64) -> (f64, f64) {
+    match k {
+        0 => (a, 0.0),
+        1 => (1.0, a),
+        2 => (1.0 - a, 1.0),
+        _ => (0.0, 1.0 - a),
+    }
+}
+
+#[test]
+fn derivatives_match_finite_differences() {
+    let s = surface(&jitter(&cube(), 0.1, 7));
+    let h = 1e-6;
+    for f in 0..6u32 {
+        for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.9), (0.5, 0.5)] {
+            let e = s.eval(SurfaceParam { patch: f, u, v });
+            let at = |u: f64, v: f64| s.eval(SurfaceParam { patch: f, u, v });
+            let du = (at(u + h, v).point - at(u - h, v).point) / (2.0 * h);
+            let dv = (at(u, v + h).point - at(u, v - h).point) / (2.0 * h);
+            assert!(
+                close(du, e.du, 1e-6) && close(dv, e.dv, 1e-6),
+                "face {f} ({u},{v})"
+            );
+            let dvv = (at(u, v + h).dv - at(u, v - h).dv) / (2.0 * h);
+            let duv = (at(u, v + h).du - at(u, v - h).du) / (2.0 * h);
+            assert!(
+                close(dvv, e.dvv, 1e-5) && close(duv, e.duv, 1e-5),
+                "face {f} ({u},{v}) second"
+            );
+        }
+    }
+}
