@@ -6,11 +6,15 @@ mod common;
 use common::linear::{sample, Linear};
 use common::{bump_grid, perturbed_z, sphere_mesh, Rng};
 use geofit::fit::{
-    Acceleration, ControlSurface, FitStatus, Fitter, SubdivFitOptions, SubdivFitter, Tolerances,
-    Weighting,
+    Acceleration, FitStatus, Fitter, SubdivFitOptions, SubdivFitter, Tolerances, Weighting,
 };
 use geofit::geom::Point3;
+use geofit::mesh::PolyMesh;
 use geofit::subdiv::LimitSurface;
+
+fn linear(mesh: PolyMesh) -> Linear {
+    Linear::try_new(&mesh).expect("triangle mesh")
+}
 
 fn exact_tol() -> Tolerances {
     Tolerances {
@@ -25,7 +29,7 @@ fn reproduce(weighting: Weighting, accel: Acceleration, max_iter: usize) -> (f64
     // control points only weakly (that is tested on smooth schemes); flat data keeps the test
     // exact and fast while the start is far off (every point moved along z).
     let truth = bump_grid(6, 0.0);
-    let surface = Linear::from_control_mesh(&truth).expect("surface");
+    let surface = Linear::try_new(&truth).expect("surface");
     let data = sample(&surface, 12, &mut Rng(1));
     let start = perturbed_z(&truth, 0.05, &mut Rng(2));
     let options = SubdivFitOptions::default()
@@ -34,7 +38,7 @@ fn reproduce(weighting: Weighting, accel: Acceleration, max_iter: usize) -> (f64
         .with_refine(false)
         .with_weighting(weighting)
         .with_acceleration(accel);
-    let mut fitter = SubdivFitter::<Linear>::try_new(&data, start, options).expect("fitter");
+    let mut fitter = SubdivFitter::with_surface(&data, linear(start), options).expect("fitter");
     let status = fitter.run().expect("run");
     assert_eq!(
         status,
@@ -52,6 +56,12 @@ fn exact_reproduction_with_basis_weights_and_anderson() {
 }
 
 #[test]
+fn exact_reproduction_with_frozen_parameter_cg() {
+    let (e, iters) = reproduce(Weighting::Basis, Acceleration::Cg { inner: 10 }, 100);
+    assert!(e < 1e-6, "E_max {e} % after {iters}");
+}
+
+#[test]
 fn exact_reproduction_with_patent_weights() {
     let (e, iters) = reproduce(Weighting::Patent, Acceleration::None, 2000);
     assert!(e < 1e-6, "E_max {e} % after {iters}");
@@ -64,7 +74,7 @@ fn foot_points_are_local_minima() {
     let data: Vec<Point3> = (0..400)
         .map(|_| rng.vec().normalize() * (1.0 + 0.05 * rng.next_f64()))
         .collect();
-    let fitter = SubdivFitter::<Linear>::try_new(&data, control, SubdivFitOptions::default())
+    let fitter = SubdivFitter::with_surface(&data, linear(control), SubdivFitOptions::default())
         .expect("fitter");
     let surface = fitter.surface();
     let converged = fitter.foot_points().iter().filter(|f| f.converged).count();
@@ -120,7 +130,7 @@ fn damping_keeps_rms_from_growing() {
             .with_acceleration(accel)
             .with_weighting(Weighting::Patent);
         let mut fitter =
-            SubdivFitter::<Linear>::try_new(&data, control.clone(), options).expect("fitter");
+            SubdivFitter::with_surface(&data, linear(control.clone()), options).expect("fitter");
         let mut last = fitter.stats().e_rms_pct;
         while fitter.step().expect("step") == FitStatus::Running {
             let now = fitter.stats().e_rms_pct;
@@ -147,7 +157,7 @@ fn refinement_stays_manifold_conforming_and_within_budget() {
         .with_max_iter(40)
         .with_max_control(Some(400))
         .with_refine_interval(3);
-    let mut fitter = SubdivFitter::<Linear>::try_new(&data, control, options).expect("fitter");
+    let mut fitter = SubdivFitter::with_surface(&data, linear(control), options).expect("fitter");
     fitter.run().expect("run");
     assert!(
         fitter.history().iter().any(|r| r.refined),
@@ -183,7 +193,8 @@ fn deterministic_across_runs() {
         let options = SubdivFitOptions::default()
             .with_max_iter(15)
             .with_refine_interval(4);
-        let mut fitter = SubdivFitter::<Linear>::try_new(&data, control, options).expect("fitter");
+        let mut fitter =
+            SubdivFitter::with_surface(&data, linear(control), options).expect("fitter");
         fitter.run().expect("run");
         let errors: Vec<u64> = fitter.point_errors().iter().map(|e| e.to_bits()).collect();
         let hist: Vec<(usize, u64)> = fitter
@@ -200,18 +211,23 @@ fn deterministic_across_runs() {
 fn bad_input_is_an_error_not_a_panic() {
     let control = sphere_mesh(0);
     let data = vec![Point3::new(0.0, f64::NAN, 0.0)];
+    assert!(SubdivFitter::with_surface(
+        &data,
+        linear(control.clone()),
+        SubdivFitOptions::default()
+    )
+    .is_err());
     assert!(
-        SubdivFitter::<Linear>::try_new(&data, control.clone(), SubdivFitOptions::default())
+        SubdivFitter::with_surface(&[], linear(control.clone()), SubdivFitOptions::default())
             .is_err()
-    );
-    assert!(
-        SubdivFitter::<Linear>::try_new(&[], control.clone(), SubdivFitOptions::default()).is_err()
     );
     let bad = SubdivFitOptions::default().with_max_iter(0);
-    assert!(SubdivFitter::<Linear>::try_new(&[Point3::ZERO], control, bad).is_err());
+    assert!(SubdivFitter::with_surface(&[Point3::ZERO], linear(control), bad).is_err());
     let empty = geofit::mesh::PolyMesh::from_points(vec![Point3::ZERO]).expect("points");
-    assert!(
-        SubdivFitter::<Linear>::try_new(&[Point3::ZERO], empty, SubdivFitOptions::default())
-            .is_err()
-    );
+    assert!(SubdivFitter::with_surface(
+        &[Point3::ZERO],
+        linear(empty),
+        SubdivFitOptions::default()
+    )
+    .is_err());
 }

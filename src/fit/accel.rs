@@ -39,6 +39,7 @@ impl Accelerator {
             Acceleration::None => add(x, d, 1.0),
             Acceleration::Relax { omega } => add(x, d, omega),
             Acceleration::Anderson { depth } => self.anderson(x, d, depth),
+            Acceleration::Cg { .. } => add(x, d, 1.0),
         }
     }
 

@@ -2,7 +2,7 @@
 //! the distance (SPEC §1.4), seeded from a spatial index over a tessellation of the surface.
 
 use super::options::NewtonOptions;
-use crate::geom::Point3;
+use crate::geom::{Point3, Vec3};
 use crate::subdiv::{LimitEval, LimitSurface, PatchDomain, SurfaceParam};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
@@ -16,6 +16,8 @@ pub struct FootPoint {
     pub point: Point3,
     /// Squared distance from the query point to `point`.
     pub dist_sq: f64,
+    /// Unit surface normal at `point` (S_u × S_v normalised; zero where degenerate).
+    pub normal: Vec3,
     /// Newton iterations used.
     pub iterations: u32,
     /// Whether Newton met its step tolerance (a clamped boundary point counts as converged when
@@ -50,6 +52,10 @@ pub fn closest_point<S: LimitSurface + ?Sized>(
             converged = true; // zero gradient: a stationary point
             break;
         };
+        if (e.du * su + e.dv * sv).length() <= tol {
+            converged = true; // the next step would not move the point: done, save the eval
+            break;
+        }
         let mut accepted = false;
         for _ in 0..8 {
             let cand = surface.relocate(at.patch, at.u + su, at.v + sv);
@@ -74,6 +80,7 @@ pub fn closest_point<S: LimitSurface + ?Sized>(
         param: at,
         point: e.point,
         dist_sq: f,
+        normal: e.du.cross(e.dv).normalize_or_zero(),
         iterations,
         converged,
     }

@@ -7,6 +7,7 @@ mod accel;
 pub mod closest;
 pub mod curve;
 mod error;
+mod frozen;
 pub mod options;
 pub mod refine;
 pub mod report;

@@ -39,6 +39,16 @@ pub enum Acceleration {
         /// How many previous iterates are combined (1..=20).
         depth: usize,
     },
+    /// Conjugate gradients on frozen foot parameters: with the foot points of this iteration
+    /// fixed, the surface is linear in the control points (S(t_i) = Σ_j B_j(t_i) P_j, the cached
+    /// limit stencils), so `inner` Jacobi-preconditioned CG steps on that least-squares problem
+    /// cost only sums over the stencils, no surface evaluation; then the foot points are
+    /// recomputed. Each CG step moves the control points by basis-weighted error vectors, like
+    /// the plain iteration, with optimal step lengths and directions. Needs basis weights.
+    Cg {
+        /// CG steps per iteration (1..=100).
+        inner: usize,
+    },
 }
 
 impl Default for Acceleration {
@@ -205,6 +215,16 @@ impl SubdivFitOptions {
             }
             Acceleration::Anderson { depth } if !(1..=20).contains(&depth) => {
                 return bad("accel", format!("Anderson depth {depth} is not in 1..=20"));
+            }
+            Acceleration::Cg { inner } if !(1..=100).contains(&inner) => {
+                return bad("accel", format!("CG steps {inner} not in 1..=100"));
+            }
+            Acceleration::Cg { .. } if self.weighting == Weighting::Patent => {
+                return bad(
+                    "accel",
+                    "CG solves the basis-weighted least-squares problem; use it with basis weights"
+                        .into(),
+                );
             }
             _ => {}
         }

@@ -48,7 +48,7 @@ impl FitReport {
         let stats = fitter.stats();
         let precompute_s = extra_precompute_s + fitter.precompute_seconds();
         FitReport {
-            scheme: S::scheme_name().to_string(),
+            scheme: fitter.surface().scheme_name().to_string(),
             points: fitter.data().len(),
             initial_control_points: fitter.initial_control_points(),
             final_control_points: fitter.num_control_points(),

@@ -3,7 +3,8 @@
 
 use super::accel::Accelerator;
 use super::closest::{closest_point, FootPoint, SurfaceIndex};
-use super::options::{SubdivFitOptions, Weighting};
+use super::frozen::Stencils;
+use super::options::{Acceleration, SubdivFitOptions, Weighting};
 use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
 use crate::geom::{Aabb, Point3, Vec3};
 use crate::mesh::PolyMesh;
@@ -15,27 +16,25 @@ use web_time::Instant;
 /// the connectivity) can continue with the same scheme.
 pub trait ControlSurface: LimitSurface + Sized {
     /// The scheme's name in reports and on the command line (`loop`, `catmull-clark`, ...).
-    fn scheme_name() -> &'static str;
+    fn scheme_name(&self) -> &'static str;
 
-    /// Turns a mesh into a valid control mesh of the scheme (e.g. quads for Catmull–Clark).
-    /// The default keeps it as it is.
-    fn prepare_control(mesh: PolyMesh) -> Result<PolyMesh, FitError> {
-        Ok(mesh)
-    }
+    /// The control mesh: polygons and current control points. Face `i` holds patch `i`'s
+    /// foot points as far as [`ControlSurface::patch_face`] says.
+    fn control_polygons(&self) -> PolyMesh;
 
-    /// The limit surface of `control` (a mesh that [`ControlSurface::prepare_control`] accepts).
-    fn from_control_mesh(control: &PolyMesh) -> Result<Self, FitError>;
+    /// The surface of the same scheme over `control` (new connectivity).
+    fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError>;
 
-    /// The face of the control mesh the surface was built from that `patch` belongs to.
+    /// The face of [`ControlSurface::control_polygons`] that `patch` belongs to.
     fn patch_face(&self, patch: u32) -> usize;
 
     /// Splits the `marked` faces of `control` (one flag per face) and what conformity needs
     /// around them, placing new points so that the limit surface changes as little as possible.
-    fn refine_control(control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError>;
+    fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError>;
 
     /// Local remeshing after a refinement (edge flips for triangle schemes). Returns the number
     /// of changes; the default makes none.
-    fn remesh_control(control: &mut PolyMesh) -> Result<usize, FitError> {
+    fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
         let _ = control;
         Ok(0)
     }
@@ -49,7 +48,6 @@ pub trait ControlSurface: LimitSurface + Sized {
 pub struct SubdivFitter<S: ControlSurface> {
     data: Vec<Point3>,
     diagonal: f64,
-    faces: PolyMesh,
     surface: S,
     feet: Vec<FootPoint>,
     signed: Vec<f64>,
@@ -66,11 +64,11 @@ pub struct SubdivFitter<S: ControlSurface> {
 }
 
 impl<S: ControlSurface> SubdivFitter<S> {
-    /// A fitter of `data_points` starting from `initial_control` (any mesh the scheme accepts;
-    /// see [`ControlSurface::prepare_control`]). Data points need no connectivity.
-    pub fn try_new(
+    /// A fitter of `data_points` starting from the limit surface `surface` (its control mesh is
+    /// the initial one). Data points need no connectivity.
+    pub fn with_surface(
         data_points: &[Point3],
-        initial_control: PolyMesh,
+        surface: S,
         options: SubdivFitOptions,
     ) -> Result<Self, FitError> {
         let start = Instant::now();
@@ -82,20 +80,18 @@ impl<S: ControlSurface> SubdivFitter<S> {
             found: 0,
             needed: 1,
         })?;
-        let control = S::prepare_control(initial_control)?;
-        if control.num_faces() == 0 {
+        let control = surface.control_polygons();
+        if control.num_faces() == 0 || surface.num_patches() == 0 {
             return Err(FitError::ControlMesh {
                 reason: "the control mesh has no faces".into(),
             });
         }
-        let surface = S::from_control_mesh(&control)?;
         let index = SurfaceIndex::build(&surface, options.index_resolution);
         let diagonal = bbox.diagonal();
         let mut fitter = SubdivFitter {
             data: data_points.to_vec(),
             diagonal: if diagonal > 0.0 { diagonal } else { 1.0 },
             initial_control: control.num_vertices(),
-            faces: control,
             surface,
             feet: Vec::new(),
             signed: Vec::new(),
@@ -136,9 +132,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
     /// The current control mesh (connectivity and control points).
     pub fn control_mesh(&self) -> PolyMesh {
-        let faces: Vec<&[u32]> = self.faces.faces().collect();
-        PolyMesh::try_new(self.surface.control_points().to_vec(), faces)
-            .unwrap_or_else(|_| self.faces.clone())
+        self.surface.control_polygons()
     }
 
     /// Number of control points now.
@@ -231,9 +225,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
     fn update_errors(&mut self) {
         self.signed.clear();
         for (p, f) in self.data.iter().zip(&self.feet) {
-            let e = self.surface.eval(f.param);
             let d = f.dist_sq.sqrt();
-            let side = (*p - f.point).dot(e.du.cross(e.dv));
+            let side = (*p - f.point).dot(f.normal);
             let s = if side < 0.0 { -d } else { d };
             self.signed.push(if s.is_finite() { s } else { f64::MAX });
         }
@@ -272,7 +265,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let old_points = self.surface.control_points().to_vec();
         let old_feet = self.feet.clone();
         let (old_signed, old_stats) = (self.signed.clone(), self.stats);
-        let d = self.moves();
+        let d = match self.options.acceleration {
+            Acceleration::Cg { inner } => {
+                let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
+                stencils.cg(&self.error_vectors(), inner)
+            }
+            _ => self.moves(),
+        };
         let proposal = self.accel.propose(&old_points, &d);
         self.surface.set_control_points(&proposal);
         self.update_feet(&old_feet);
@@ -302,7 +301,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// Faces to split: those holding a point beyond the E_max tolerance, or whose mean distance
     /// exceeds the E_avg (or E_rms) tolerance; worst first, as many as the budget allows.
     fn faces_to_split(&self) -> Vec<usize> {
-        let nf = self.faces.num_faces();
+        let control = self.control_mesh();
+        let nf = control.num_faces();
         let (mut max, mut sum, mut sum_sq, mut count) = (
             vec![0.0f64; nf],
             vec![0.0; nf],
@@ -338,7 +338,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let mut edges = HashSet::new();
         let mut chosen = Vec::new();
         for (_, f) in scored {
-            let face = self.faces.face(f);
+            let face = control.face(f);
             for k in 0..face.len() {
                 let (a, b) = (face[k], face[(k + 1) % face.len()]);
                 edges.insert((a.min(b), a.max(b)));
@@ -361,13 +361,12 @@ impl<S: ControlSurface> SubdivFitter<S> {
             for &f in &chosen {
                 marked[f] = true;
             }
-            let mut refined = S::refine_control(&control, &marked)?;
+            let mut refined = self.surface.refine_control(&control, &marked)?;
             if refined.num_vertices() <= self.budget() {
                 if self.options.remesh {
-                    S::remesh_control(&mut refined)?;
+                    self.surface.remesh_control(&mut refined)?;
                 }
-                self.surface = S::from_control_mesh(&refined)?;
-                self.faces = refined;
+                self.surface = self.surface.rebuild(&refined)?;
                 self.index = SurfaceIndex::build(&self.surface, self.options.index_resolution);
                 self.accel.reset();
                 self.search_all_feet()?;

@@ -88,10 +88,26 @@ impl LimitSurface for Linear {
 }
 
 impl ControlSurface for Linear {
-    fn scheme_name() -> &'static str {
+    fn scheme_name(&self) -> &'static str {
         "linear"
     }
-    fn from_control_mesh(control: &PolyMesh) -> Result<Self, FitError> {
+    fn control_polygons(&self) -> PolyMesh {
+        PolyMesh::try_new(self.points.clone(), &self.tris).expect("valid by construction")
+    }
+    fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError> {
+        Linear::try_new(control)
+    }
+    fn patch_face(&self, patch: u32) -> usize {
+        patch as usize
+    }
+    fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
+        split_triangles(control, marked, SplitRule::Midpoint)
+    }
+}
+
+impl Linear {
+    /// The surface of a triangle mesh.
+    pub fn try_new(control: &PolyMesh) -> Result<Self, FitError> {
         let tris = geofit::fit::refine::triangles_of(control)?;
         let mut owner: HashMap<(u32, u32), (u32, usize)> = HashMap::new();
         for (f, t) in tris.iter().enumerate() {
@@ -114,12 +130,6 @@ impl ControlSurface for Linear {
             tris,
             across,
         })
-    }
-    fn patch_face(&self, patch: u32) -> usize {
-        patch as usize
-    }
-    fn refine_control(control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
-        split_triangles(control, marked, SplitRule::Midpoint)
     }
 }
 
