@@ -4,6 +4,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod info;
+mod simplify;
 
 #[derive(Parser)]
 #[command(
@@ -20,12 +21,16 @@ struct Cli {
 enum Command {
     /// Describe a point or mesh file.
     Info(info::Args),
+    /// Simplify a mesh by quadric error metrics to a target vertex count (the initial control
+    /// mesh of a fit), timed, with its distance to the input.
+    Simplify(simplify::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => info::run(args),
+        Command::Simplify(args) => simplify::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -39,8 +39,6 @@ pub(super) struct Work {
     ref_normal: Vec<Vec3>,
     /// Faces incident to each vertex; empty for removed or unreferenced vertices.
     pub(super) vfaces: Vec<Vec<u32>>,
-    /// Bumped whenever a vertex's position or quadric changes, to invalidate queued candidates.
-    pub(super) stamp: Vec<u32>,
     /// Number of vertices with at least one face.
     pub(super) live: usize,
     scratch_u: Vec<u32>,
@@ -67,7 +65,6 @@ impl Work {
         Work {
             ref_normal,
             quadric: vec![Quadric::default(); pos.len()],
-            stamp: vec![0; pos.len()],
             tri_alive: vec![true; tris.len()],
             pos,
             tris,
@@ -206,8 +203,6 @@ impl Work {
         let qv = self.quadric[v as usize];
         self.quadric[u as usize] += qv;
         self.pos[u as usize] = p;
-        self.stamp[u as usize] = self.stamp[u as usize].wrapping_add(1);
-        self.stamp[v as usize] = self.stamp[v as usize].wrapping_add(1);
         self.live -= 1;
     }
 }

@@ -38,6 +38,7 @@ mod collapse;
 mod deviation;
 mod error;
 mod quadric;
+mod queue;
 
 pub use deviation::{deviation, Deviation};
 pub use error::SimplifyError;
@@ -46,8 +47,7 @@ use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use collapse::{Limits, Work};
 use quadric::Quadric;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
+use queue::{Candidate, Queue};
 
 /// Settings of [`simplify_with`]. Build with `SimplifyOptions::default()` and the `with_*`
 /// setters.
@@ -262,42 +262,6 @@ fn init_quadrics(work: &mut Work, boundary_weight: f64) {
     }
 }
 
-/// A queued edge collapse, valid while both end stamps match the mesh's. Kept small (the heap
-/// holds a few hundred thousand of them); the target position is recomputed when it is popped.
-#[derive(Clone, Copy, Debug)]
-struct Candidate {
-    cost: f64,
-    u: u32,
-    v: u32,
-    stamp_u: u32,
-    stamp_v: u32,
-}
-
-impl PartialEq for Candidate {
-    fn eq(&self, other: &Candidate) -> bool {
-        self.cmp(other) == Ordering::Equal
-    }
-}
-
-impl Eq for Candidate {}
-
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, other: &Candidate) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Candidate {
-    /// Reversed, so that the max-heap pops the cheapest collapse, ties going to lower indices.
-    fn cmp(&self, other: &Candidate) -> Ordering {
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then(other.u.cmp(&self.u))
-            .then(other.v.cmp(&self.v))
-    }
-}
-
 /// How far (in edge lengths from the edge midpoint) the quadric's optimum may lie before it is
 /// distrusted as the product of a nearly singular system.
 const MAX_OPTIMUM_OFFSET: f64 = 2.0;
@@ -328,13 +292,11 @@ fn candidate(work: &Work, u: u32, v: u32) -> Candidate {
         cost: placement(work, u, v).1,
         u,
         v,
-        stamp_u: work.stamp[u as usize],
-        stamp_v: work.stamp[v as usize],
     }
 }
 
 /// Every edge of the current mesh as a candidate.
-fn all_candidates(work: &Work) -> BinaryHeap<Candidate> {
+fn all_candidates(work: &Work) -> Queue {
     let mut heap = Vec::new();
     for (f, t) in work.tris.iter().enumerate() {
         if !work.tri_alive[f] {
@@ -347,9 +309,11 @@ fn all_candidates(work: &Work) -> BinaryHeap<Candidate> {
     }
     heap.sort_unstable();
     heap.dedup();
-    heap.into_iter()
-        .map(|(u, v)| candidate(work, u, v))
-        .collect()
+    Queue::from_vec(
+        heap.into_iter()
+            .map(|(u, v)| candidate(work, u, v))
+            .collect(),
+    )
 }
 
 /// Collapses edges until `target` vertices are left.
@@ -378,12 +342,13 @@ fn reduce(work: &mut Work, target: usize, options: &SimplifyOptions) -> Result<(
             progress_since_rebuild = false;
             continue;
         };
-        let (u, v) = (c.u as usize, c.v as usize);
-        if work.stamp[u] != c.stamp_u || work.stamp[v] != c.stamp_v || work.vfaces[u].is_empty() {
+        if work.vfaces[c.u as usize].is_empty() || work.vfaces[c.v as usize].is_empty() {
             continue;
         }
-        let (target, _) = placement(work, c.u, c.v);
-        if !work.allows(c.u, c.v, target, &limits) {
+        // A candidate is stale once an end has moved: its cost then differs from the current
+        // one, which was queued anew when the end moved.
+        let (target, cost) = placement(work, c.u, c.v);
+        if cost.to_bits() != c.cost.to_bits() || !work.allows(c.u, c.v, target, &limits) {
             continue;
         }
         work.collapse(c.u, c.v, target);
