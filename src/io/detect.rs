@@ -7,7 +7,8 @@ const SNIFF_BYTES: usize = 64 * 1024;
 
 /// The format of `bytes`. Unambiguous content wins (PLY magic, a binary STL whose size matches
 /// its triangle count, `solid`, OBJ statements, rows of numbers); the name's extension decides
-/// only when the content does not, so that a damaged `.ply` still gets a PLY error message.
+/// only when the content does not, so that a damaged `.ply` still gets a PLY error message;
+/// last, a binary STL with padding after its triangles is recognised.
 pub fn detect(bytes: &[u8], name: Option<&str>) -> Option<Format> {
     if bytes.starts_with(b"ply") && matches!(bytes.get(3), Some(b'\n' | b'\r')) {
         return Some(Format::Ply);
@@ -16,7 +17,9 @@ pub fn detect(bytes: &[u8], name: Option<&str>) -> Option<Format> {
         return Some(Format::Stl);
     }
     let head = &bytes[..bytes.len().min(SNIFF_BYTES)];
-    classify_text(head).or_else(|| name.and_then(from_name))
+    classify_text(head)
+        .or_else(|| name.and_then(from_name))
+        .or_else(|| stl::looks_binary(bytes).then_some(Format::Stl))
 }
 
 /// The format a file name's extension suggests.

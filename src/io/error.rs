@@ -25,10 +25,19 @@ impl fmt::Display for Location {
 /// the line or byte offset.
 ///
 /// ```
-/// use geofit::io::{read_bytes, ReadError};
-/// let err = read_bytes(b"v 1 2 zz\n", Some("a.obj")).unwrap_err();
-/// assert!(matches!(err, ReadError::Syntax { .. }));
-/// assert_eq!(err.to_string(), "OBJ line 1: expected a number, found 'zz'");
+/// use geofit::io::{read_bytes, read_path, ReadError};
+/// let msg = |bytes: &[u8]| read_bytes(bytes, None).unwrap_err().to_string();
+/// assert_eq!(msg(b""), "the file is empty");
+/// assert!(msg(b"\x00\x01").starts_with("unknown file format"));
+/// assert_eq!(msg(b"v 1 2 zz\n"), "OBJ line 1: expected a number, found 'zz'");
+/// assert_eq!(msg(b"v 1 2 3\nf 1 2 4\n"), "OBJ line 2: vertex index 4 is out of range (the file has 1 vertices)");
+/// assert_eq!(msg(b"1 2 3\n4 nan 6\n"), "XYZ line 2: coordinate is not a finite number");
+/// assert_eq!(
+///     msg(b"ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n\0\0\0\0\0\0\0"),
+///     "PLY byte 102: file ends early: while reading property 'y' of vertex 0 (of 1)"
+/// );
+/// assert_eq!(read_bytes(b"# only a comment\n", Some("a.obj")).unwrap_err().to_string(), "OBJ: the file has no points");
+/// assert!(matches!(read_path("/no/such/file.ply".as_ref()), Err(ReadError::Io(_))));
 /// ```
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]

@@ -4,9 +4,13 @@
 //! (line or byte offset); no input makes a reader panic or hang, and no header count makes a
 //! reader reserve more memory than the bytes that follow could fill.
 //!
-//! The parsers are hand-written: the PLY, OBJ and STL crates on crates.io were evaluated and
-//! either lose data (unreferenced OBJ vertices, OBJ `l` lines), lack error locations, or are
-//! several times too slow for interactive loading (see the io module's history for numbers).
+//! The parsers are hand-written. The crates made for these formats were tried on the shared
+//! scans and on mutated inputs (none panicked), but none fits: `ply-rs-bw` 4.0 parses
+//! bun000.ply in about 0.5 s with its generic element maps (these readers: about 20 ms) and
+//! locates binary errors by header line only; `tobj` 4.0 keeps only vertices that faces use
+//! (34,834 of the bunny's 35,947), drops `l` polylines and reports errors without line
+//! numbers; `stl_io` 0.11 reports errors without a location. Tristrips and range grids would
+//! need code on top of any of them anyway.
 //!
 //! ```
 //! let file = geofit::io::read_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", Some("tri.obj"))?;

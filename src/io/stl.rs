@@ -20,6 +20,16 @@ pub fn is_binary(bytes: &[u8]) -> bool {
         .is_some_and(|n| (HEADER as u64) + (TRIANGLE as u64) * n == bytes.len() as u64)
 }
 
+/// Whether the file is binary STL, allowing for exporters that pad the end or start the
+/// header with `solid`: exact size, or room for the declared triangles and a NUL or non-ASCII
+/// byte in the first triangles, which ASCII STL never has.
+pub fn looks_binary(bytes: &[u8]) -> bool {
+    let fits = declared_triangles(bytes)
+        .is_some_and(|n| (HEADER as u64) + (TRIANGLE as u64) * n <= bytes.len() as u64);
+    let data = bytes.get(HEADER..).unwrap_or_default();
+    is_binary(bytes) || (fits && data.iter().take(8 * TRIANGLE).any(|&b| b == 0 || b > 127))
+}
+
 fn declared_triangles(bytes: &[u8]) -> Option<u64> {
     let count: [u8; 4] = bytes.get(80..84)?.try_into().ok()?;
     Some(u64::from(u32::from_le_bytes(count)))
@@ -27,7 +37,7 @@ fn declared_triangles(bytes: &[u8]) -> Option<u64> {
 
 pub fn read(bytes: &[u8]) -> Result<LoadedFile, ReadError> {
     let starts_solid = tokens(bytes.get(..HEADER).unwrap_or(bytes)).next() == Some(b"solid");
-    if starts_solid && !is_binary(bytes) {
+    if starts_solid && !looks_binary(bytes) {
         read_ascii(bytes)
     } else {
         read_binary(bytes)
@@ -193,6 +203,22 @@ mod tests {
         assert_eq!(e.to_string(), "STL line 12: expected a number, found 'q'");
         let e = read(&ASCII[..56]).unwrap_err();
         assert!(matches!(e, ReadError::Truncated { .. }), "{e}");
+    }
+
+    #[test]
+    fn padded_binary_with_solid_header() {
+        let mut b = b"solid exported".to_vec();
+        b.resize(80, b' ');
+        b.extend(1u32.to_le_bytes());
+        for v in [
+            0.0f32, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+        ] {
+            b.extend(v.to_le_bytes());
+        }
+        b.extend([0; 2 + 7]); // attribute, then 7 bytes of padding
+        let f = read(&b).unwrap();
+        assert_eq!(f.mesh.num_vertices(), 3);
+        assert_eq!(super::super::read_bytes(&b, None).unwrap().format, STL);
     }
 
     #[test]

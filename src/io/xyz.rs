@@ -2,28 +2,46 @@
 //! commas or semicolons; leading non-numeric lines are a header; `#` and `//` lines are
 //! comments; a line holding one integer is a PTS point count and is skipped; columns beyond
 //! x, y, z (intensity, colour, normals) are ignored. Files with two numeric columns are 2D
-//! points (z = 0).
+//! points (z = 0). In a line separated by semicolons a comma is a decimal comma (`1,5;2,5`),
+//! as spreadsheets in many locales write CSV.
 
-use super::text::{coordinate, lines, parse_f64, parse_i64};
+use super::text::{coordinate, lines, parse_f64, parse_i64, show};
 use super::{Format, LoadedFile, Location, ReadError};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
+use std::borrow::Cow;
 
 const XYZ: Format = Format::Xyz;
 
 /// The fields of a line, without surrounding quotes.
 fn fields(line: &[u8]) -> impl Iterator<Item = &[u8]> {
-    line.split(|&b| b.is_ascii_whitespace() || b == b',' || b == b';')
+    let comma_separates = !line.contains(&b';');
+    line.split(move |&b| b.is_ascii_whitespace() || b == b';' || (comma_separates && b == b','))
         .filter(|f| !f.is_empty())
         .map(|f| f.strip_prefix(b"\"").unwrap_or(f))
         .map(|f| f.strip_suffix(b"\"").unwrap_or(f))
+}
+
+/// A field with a decimal comma turned into a point (fields only keep commas in
+/// semicolon-separated lines).
+fn decimal_point(field: &[u8]) -> Cow<'_, [u8]> {
+    if field.contains(&b',') {
+        Cow::Owned(
+            field
+                .iter()
+                .map(|&b| if b == b',' { b'.' } else { b })
+                .collect(),
+        )
+    } else {
+        Cow::Borrowed(field)
+    }
 }
 
 /// How many leading fields (at most three) are numbers: 2 or 3 for a point line.
 pub fn numeric_fields(line: &[u8]) -> usize {
     fields(line)
         .take(3)
-        .take_while(|f| parse_f64(f).is_some())
+        .take_while(|f| parse_f64(&decimal_point(f)).is_some())
         .count()
 }
 
@@ -70,9 +88,24 @@ fn point(line: &[u8], line_no: usize, columns: usize) -> Result<Point3, ReadErro
             at,
             message: format!("expected {columns} numbers, found {k}"),
         })?;
-        *c = coordinate(t, XYZ, at)?;
+        *c = field_coordinate(t, at)?;
     }
     Ok(Point3::from_array(xyz))
+}
+
+/// A coordinate field, read with [`decimal_point`]; errors quote the field as written.
+fn field_coordinate(field: &[u8], at: Location) -> Result<f64, ReadError> {
+    match decimal_point(field) {
+        Cow::Borrowed(f) => coordinate(f, XYZ, at),
+        Cow::Owned(f) => coordinate(&f, XYZ, at).map_err(|e| match e {
+            ReadError::Syntax { .. } => ReadError::Syntax {
+                format: XYZ,
+                at,
+                message: format!("expected a number, found '{}'", show(field)),
+            },
+            other => other,
+        }),
+    }
 }
 
 #[cfg(test)]
@@ -84,6 +117,17 @@ mod tests {
         let f = read(b"x;y;z;i\n# c\n1;2;3;9\n\"4\",\"5\",\"6\"\n").unwrap();
         assert_eq!(f.mesh.positions()[1], Point3::new(4.0, 5.0, 6.0));
         assert_eq!(f.dimension, 3);
+    }
+
+    #[test]
+    fn semicolons_with_decimal_commas() {
+        let f = read(b"x;y;z\n1,5;-2,25;3\n").unwrap();
+        assert_eq!(f.mesh.positions()[0], Point3::new(1.5, -2.25, 3.0));
+        let e = read(b"1;2;3\n1,5,1;2;3\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "XYZ line 2: expected a number, found '1,5,1'"
+        );
     }
 
     #[test]
