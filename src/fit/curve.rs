@@ -148,6 +148,8 @@ pub(crate) struct CurveData {
     /// last point sits before 1.
     pub chord: Vec<f64>,
     pub diagonal: f64,
+    /// Length of the polyline (closing segment included for closed curves).
+    pub length: f64,
     /// All points share one z: errors get a sign from the in-plane normal.
     pub planar: bool,
 }
@@ -188,6 +190,7 @@ impl CurveData {
         Ok(CurveData {
             planar: bbox.max.z == bbox.min.z,
             diagonal: bbox.diagonal(),
+            length: total,
             points,
             chord,
         })

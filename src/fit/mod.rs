@@ -6,8 +6,10 @@
 mod accel;
 pub mod closest;
 pub mod curve;
+mod curve_lsq;
 mod error;
 mod frozen;
+pub mod knot_placement;
 pub mod options;
 pub mod refine;
 pub mod report;
@@ -16,7 +18,9 @@ pub mod subdiv;
 
 pub use closest::FootPoint;
 pub use curve::{CurveFitOptions, CurveFitter};
+pub use curve_lsq::least_squares_curve;
 pub use error::FitError;
+pub use knot_placement::{KnotPlacementFitter, KnotPlacementOptions};
 pub use options::{Acceleration, SubdivFitOptions, Weighting};
 pub use report::FitReport;
 pub use stats::{ErrorStats, IterationRecord, Tolerances};

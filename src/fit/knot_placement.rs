@@ -1,0 +1,547 @@
+//! Knot placement for least-squares B-spline curve fitting (SPEC §3, seed 004).
+//!
+//! 1. At every data point, a cubic through the 4 points before it and one through the 4 points
+//!    after it (chord-length parameters) are compared. Where their second derivatives differ by
+//!    more than a threshold, the curve gets a multiple knot, largest jump first, with at least 2
+//!    data points between multiple knots. Where their tangents differ by more than an angle, the
+//!    point is a corner: multiplicity p (C0, the tangent jump is kept); otherwise a double knot
+//!    (multiplicity p − 1: C1 with a curvature jump).
+//! 2. The control points are solved by least squares, each data point's normal deviation (its
+//!    distance to its foot point) is measured, and one single knot is inserted at the foot
+//!    parameter of the largest deviation — keeping at least 1 data point between knots and 2
+//!    next to a multiple knot, otherwise the next largest deviation is tried — until the
+//!    tolerances (and the standard deviation bound, when given) are met.
+//!
+//! Each [`Fitter::step`] is one insertion and one solve.
+
+use super::curve::{check_tolerances, CurveData};
+use super::curve_lsq::least_squares_curve;
+use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord, Tolerances};
+use crate::geom::{Point3, Vec3};
+use crate::spline::{BSplineCurve, MAX_CURVE_DEGREE};
+use web_time::Instant;
+
+/// Options of the knot-placement fitter. Defaults in brackets on each field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct KnotPlacementOptions {
+    /// Degree, 1..=5 [3].
+    pub degree: usize,
+    /// Closed (periodic) curve [false].
+    pub closed: bool,
+    /// Stop when these are met [E_avg 0.01 %, E_max 0.05 %].
+    pub tolerances: Tolerances,
+    /// Also require the standard deviation of the signed normal deviations below this, % of
+    /// the bbox diagonal (the seed's criterion) [none].
+    pub std_pct: Option<f64>,
+    /// Second-derivative jump |S₁'' − S₂''| that makes a double knot, in units of 1 / bbox
+    /// diagonal [1000]. Sections of triangle meshes are polylines whose local cubics jump by
+    /// a few hundred everywhere, so lower values put double knots on noise.
+    pub curvature_jump: f64,
+    /// Angle that makes a corner, degrees: both the tangents S₁', S₂' and the polyline's
+    /// segments at the point must turn by more [30].
+    pub corner_angle_deg: f64,
+    /// Cap on single-knot insertions [the number of data points].
+    pub max_iter: Option<usize>,
+    /// Re-parameterise the data by their foot points after each solve [false]. It can lower
+    /// the control-point count, but on noisy sections points may jump to a neighbouring
+    /// wiggle and the fit diverges; the seed keeps the chord-length parameters.
+    pub parameter_correction: bool,
+    /// Newton iterations per foot point [12].
+    pub newton_iter: usize,
+}
+
+impl Default for KnotPlacementOptions {
+    fn default() -> Self {
+        KnotPlacementOptions {
+            degree: 3,
+            closed: false,
+            tolerances: Tolerances::default(),
+            std_pct: None,
+            curvature_jump: 1000.0,
+            corner_angle_deg: 30.0,
+            max_iter: None,
+            parameter_correction: false,
+            newton_iter: 12,
+        }
+    }
+}
+
+impl KnotPlacementOptions {
+    /// Sets the degree.
+    pub fn with_degree(mut self, degree: usize) -> Self {
+        self.degree = degree;
+        self
+    }
+    /// Sets whether the curve is closed.
+    pub fn with_closed(mut self, closed: bool) -> Self {
+        self.closed = closed;
+        self
+    }
+    /// Sets the tolerances.
+    pub fn with_tolerances(mut self, tolerances: Tolerances) -> Self {
+        self.tolerances = tolerances;
+        self
+    }
+    /// Sets the standard-deviation bound, %.
+    pub fn with_std_pct(mut self, std_pct: Option<f64>) -> Self {
+        self.std_pct = std_pct;
+        self
+    }
+    /// Sets the second-derivative jump threshold (units of 1 / bbox diagonal).
+    pub fn with_curvature_jump(mut self, jump: f64) -> Self {
+        self.curvature_jump = jump;
+        self
+    }
+    /// Sets the corner angle, degrees.
+    pub fn with_corner_angle_deg(mut self, angle: f64) -> Self {
+        self.corner_angle_deg = angle;
+        self
+    }
+    /// Sets the cap on insertions.
+    pub fn with_max_iter(mut self, max_iter: Option<usize>) -> Self {
+        self.max_iter = max_iter;
+        self
+    }
+    /// Sets whether parameters are corrected between solves.
+    pub fn with_parameter_correction(mut self, on: bool) -> Self {
+        self.parameter_correction = on;
+        self
+    }
+
+    fn validate(&self) -> Result<(), FitError> {
+        let bad = |name, reason: String| Err(FitError::InvalidOption { name, reason });
+        if !(1..=MAX_CURVE_DEGREE).contains(&self.degree) {
+            return bad(
+                "degree",
+                format!("{} is not in 1..={MAX_CURVE_DEGREE}", self.degree),
+            );
+        }
+        if !(self.curvature_jump.is_finite() && self.curvature_jump > 0.0) {
+            return bad(
+                "curvature-jump",
+                format!("{} must be positive", self.curvature_jump),
+            );
+        }
+        if !(self.corner_angle_deg > 0.0 && self.corner_angle_deg <= 180.0) {
+            return bad(
+                "corner-angle",
+                format!("{} is not in (0, 180]", self.corner_angle_deg),
+            );
+        }
+        if let Some(s) = self.std_pct.filter(|s| !(s.is_finite() && *s >= 0.0)) {
+            return bad("tol-std", format!("{s} is not a non-negative percentage"));
+        }
+        check_tolerances(&self.tolerances)
+    }
+}
+
+/// A data point where the shape is not C2: it gets a multiple knot.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Feature {
+    /// Index of the data point.
+    pub index: usize,
+    /// Its chord-length parameter, the knot value.
+    pub param: f64,
+    /// Knot multiplicity: p for a corner, p − 1 for a curvature jump.
+    pub multiplicity: usize,
+    /// |S₁'' − S₂''| times the bbox diagonal.
+    pub jump: f64,
+    /// The smaller of the angle between S₁' and S₂' and the polyline's turn there, degrees.
+    pub angle_deg: f64,
+}
+
+/// Value, first and second derivative at `x` of the cubic through `(xs[k], ys[k])`, by Newton
+/// divided differences.
+fn cubic_derivs(xs: [f64; 4], ys: [Point3; 4], x: f64) -> (Vec3, Vec3) {
+    let d1: Vec<Vec3> = (0..3)
+        .map(|k| (ys[k + 1] - ys[k]) / (xs[k + 1] - xs[k]))
+        .collect();
+    let d2: Vec<Vec3> = (0..2)
+        .map(|k| (d1[k + 1] - d1[k]) / (xs[k + 2] - xs[k]))
+        .collect();
+    let d3 = (d2[1] - d2[0]) / (xs[3] - xs[0]);
+    let (a, b, c) = (x - xs[0], x - xs[1], x - xs[2]);
+    let first = d1[0] + d2[0] * (a + b) + d3 * (a * b + a * c + b * c);
+    let second = 2.0 * d2[0] + 2.0 * d3 * (a + b + c);
+    (first, second)
+}
+
+/// The multiple-knot features of `data` (SPEC §3 step 1), largest first and spaced.
+pub(crate) fn detect_features(
+    data: &CurveData,
+    closed: bool,
+    degree: usize,
+    options: &KnotPlacementOptions,
+) -> Vec<Feature> {
+    let pts = &data.points;
+    let n = pts.len();
+    // Arc length along the polyline (unnormalised), so S'' is a curvature vector.
+    let len: Vec<f64> = data.chord.iter().map(|c| c * data.length).collect();
+    let at = |k: isize| -> (f64, Point3) {
+        let q = k.div_euclid(n as isize) as f64;
+        let i = k.rem_euclid(n as isize) as usize;
+        (len[i] + q * data.length, pts[i])
+    };
+    let range = if closed { 0..n } else { 3..n.saturating_sub(3) };
+    let mut found: Vec<Feature> = Vec::new();
+    for i in range {
+        let i_s = i as isize;
+        let side = |ks: [isize; 4]| {
+            let v: Vec<(f64, Point3)> = ks.iter().map(|&k| at(k)).collect();
+            cubic_derivs(
+                [v[0].0, v[1].0, v[2].0, v[3].0],
+                [v[0].1, v[1].1, v[2].1, v[3].1],
+                at(i_s).0,
+            )
+        };
+        let (t1, s1) = side([i_s - 3, i_s - 2, i_s - 1, i_s]);
+        let (t2, s2) = side([i_s, i_s + 1, i_s + 2, i_s + 3]);
+        let jump = (s1 - s2).length() * data.diagonal;
+        // A corner must show in the local cubics' tangents and in the polyline's own turn at
+        // the point: unevenly spaced points alone can tilt a cubic's end tangent, and a
+        // tangent-continuous fillet end turns the polyline only a little.
+        let (prev, here, next) = (at(i_s - 1).1, pts[i], at(i_s + 1).1);
+        let turn = (here - prev).angle_between(next - here).to_degrees();
+        let angle_deg = t1.angle_between(t2).to_degrees().min(turn);
+        let corner = angle_deg > options.corner_angle_deg;
+        if corner || jump > options.curvature_jump {
+            found.push(Feature {
+                index: i,
+                param: data.chord[i],
+                multiplicity: if corner { degree } else { (degree - 1).max(1) },
+                jump,
+                angle_deg,
+            });
+        }
+    }
+    // Corners first, then by jump; keep ≥ 2 data points between accepted features.
+    found.sort_by(|a, b| {
+        b.multiplicity
+            .cmp(&a.multiplicity)
+            .then(b.jump.total_cmp(&a.jump))
+    });
+    let gap = |a: usize, b: usize| {
+        let d = a.abs_diff(b);
+        if closed {
+            d.min(n - d)
+        } else {
+            d
+        }
+    };
+    let mut kept: Vec<Feature> = Vec::new();
+    for f in found {
+        if kept.iter().all(|k| gap(k.index, f.index) >= 3) {
+            kept.push(f);
+        }
+    }
+    kept.sort_by(|a, b| a.param.total_cmp(&b.param));
+    kept
+}
+
+/// One knot value with its multiplicity, as the fitter tracks them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Knot {
+    value: f64,
+    multiplicity: usize,
+}
+
+/// The knot-placement least-squares fitter (SPEC §3), driven through [`Fitter`].
+#[derive(Clone, Debug)]
+pub struct KnotPlacementFitter {
+    data: CurveData,
+    options: KnotPlacementOptions,
+    features: Vec<Feature>,
+    /// Interior knots (open) or one period of knots from the seam (closed), sorted.
+    knots: Vec<Knot>,
+    curve: BSplineCurve,
+    params: Vec<f64>,
+    errors: Vec<f64>,
+    stats: ErrorStats,
+    history: Vec<IterationRecord>,
+    status: FitStatus,
+    initial_control: usize,
+}
+
+impl KnotPlacementFitter {
+    /// Detects the features of the ordered `points`, places their multiple knots and solves
+    /// the first least-squares curve.
+    pub fn try_new(
+        points: &[Point3],
+        options: KnotPlacementOptions,
+    ) -> Result<KnotPlacementFitter, FitError> {
+        options.validate()?;
+        let p = options.degree;
+        let data = CurveData::try_new(points, options.closed, (2 * p + 2).max(8))?;
+        let features = detect_features(&data, options.closed, p, &options);
+        let mut knots: Vec<Knot> = features
+            .iter()
+            .map(|f| Knot {
+                value: f.param,
+                multiplicity: f.multiplicity,
+            })
+            .collect();
+        if options.closed {
+            top_up_periodic(&mut knots, &data.chord, p + 1);
+        }
+        let params = data.chord.clone();
+        let template = template_curve(&knots, p, options.closed, &data.points)?;
+        let curve = least_squares_curve(&template, &data.points, &params)?;
+        let mut fitter = KnotPlacementFitter {
+            initial_control: curve.control_points().len(),
+            data,
+            options,
+            features,
+            knots,
+            curve,
+            params,
+            errors: Vec::new(),
+            stats: ErrorStats::default(),
+            history: Vec::new(),
+            status: FitStatus::Running,
+        };
+        fitter.measure();
+        if fitter.met() {
+            fitter.status = FitStatus::Converged;
+        }
+        Ok(fitter)
+    }
+
+    /// The current curve.
+    pub fn curve(&self) -> &BSplineCurve {
+        &self.curve
+    }
+
+    /// The detected features (multiple knots).
+    pub fn features(&self) -> &[Feature] {
+        &self.features
+    }
+
+    /// The data points.
+    pub fn data(&self) -> &[Point3] {
+        &self.data.points
+    }
+
+    /// The foot-point parameter of every data point.
+    pub fn params(&self) -> &[f64] {
+        &self.params
+    }
+
+    /// Control points of the first (features-only) curve.
+    pub fn initial_control_points(&self) -> usize {
+        self.initial_control
+    }
+
+    /// Where the fit stands.
+    pub fn status(&self) -> FitStatus {
+        self.status
+    }
+
+    /// Standard deviation of the signed normal deviations, % of the bbox diagonal.
+    pub fn std_pct(&self) -> f64 {
+        let n = self.errors.len().max(1) as f64;
+        let mean = self.errors.iter().sum::<f64>() / n;
+        let var = self.errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / n;
+        var.sqrt() / self.data.diagonal * 100.0
+    }
+
+    fn met(&self) -> bool {
+        self.options.tolerances.met_by(&self.stats)
+            && self.options.std_pct.is_none_or(|s| self.std_pct() <= s)
+    }
+
+    /// Foot points (normal deviations) of the data on the current curve.
+    fn measure(&mut self) {
+        let mut params = self.params.clone();
+        self.errors = self
+            .data
+            .foot_points(&self.curve, &mut params, self.options.newton_iter);
+        if self.options.parameter_correction {
+            self.params = params;
+        }
+        self.stats = ErrorStats::from_distances(&self.errors, self.data.diagonal);
+    }
+
+    /// The foot parameter of the largest admissible deviation, per the spacing rules.
+    fn next_knot(&self) -> Option<f64> {
+        let mut order: Vec<usize> = (0..self.errors.len()).collect();
+        order.sort_by(|&a, &b| self.errors[b].abs().total_cmp(&self.errors[a].abs()));
+        order
+            .into_iter()
+            .map(|i| self.curve.normalize_param(self.params[i]))
+            .find(|&u| self.admissible(u))
+    }
+
+    /// Whether a single knot at `u` keeps ≥ 1 data point to each neighbouring knot (2 to a
+    /// multiple knot). A point exactly at a knot counts for the span on its left, so knots at
+    /// the foot points of consecutive data points remain possible.
+    fn admissible(&self, u: f64) -> bool {
+        let (a, b) = self.curve.domain();
+        let period = b - a;
+        let wrap = |x: f64| {
+            if self.options.closed {
+                a + (x - a).rem_euclid(period)
+            } else {
+                x
+            }
+        };
+        let mut left = Knot {
+            value: a,
+            multiplicity: 1,
+        };
+        let mut right = Knot {
+            value: b,
+            multiplicity: 1,
+        };
+        for k in &self.knots {
+            let v = wrap(k.value);
+            if v == u {
+                return false;
+            }
+            if v < u && v >= left.value {
+                left = Knot { value: v, ..*k };
+            }
+            if v > u && v <= right.value {
+                right = Knot { value: v, ..*k };
+            }
+        }
+        if self.options.closed {
+            // The seam knot bounds both ends of the domain.
+            if let Some(seam) = self.knots.iter().find(|k| wrap(k.value) == a) {
+                if left.value == a {
+                    left.multiplicity = seam.multiplicity;
+                }
+                if right.value == b {
+                    right.multiplicity = seam.multiplicity;
+                }
+            }
+        }
+        let need = |k: &Knot| if k.multiplicity > 1 { 2 } else { 1 };
+        let count = |lo: f64, hi: f64| {
+            self.params
+                .iter()
+                .map(|&t| self.curve.normalize_param(t))
+                .filter(|&t| t > lo && t <= hi)
+                .count()
+        };
+        count(left.value, u) >= need(&left) && count(u, right.value) >= need(&right)
+    }
+}
+
+/// For a closed curve: at least `min` control points (knots per period), by adding single
+/// knots at evenly spread data parameters away from the existing ones.
+fn top_up_periodic(knots: &mut Vec<Knot>, chord: &[f64], min: usize) {
+    let total = |k: &[Knot]| k.iter().map(|k| k.multiplicity).sum::<usize>();
+    let n = chord.len();
+    let mut slots = 2 * min;
+    while total(knots) < min && slots <= n {
+        knots.retain(|k| k.multiplicity > 1);
+        for s in 0..slots {
+            let u = chord[s * n / slots];
+            let near = knots
+                .iter()
+                .any(|k| (k.value - u).abs() < 0.5 / slots as f64);
+            if !near {
+                knots.push(Knot {
+                    value: u,
+                    multiplicity: 1,
+                });
+            }
+        }
+        knots.sort_by(|a, b| a.value.total_cmp(&b.value));
+        slots *= 2;
+    }
+}
+
+/// A curve with the given knots (control points placed on the data, only as a starting value
+/// for the ridge term of the least-squares solve).
+fn template_curve(
+    knots: &[Knot],
+    p: usize,
+    closed: bool,
+    points: &[Point3],
+) -> Result<BSplineCurve, FitError> {
+    let mut flat: Vec<f64> = Vec::new();
+    for k in knots {
+        flat.extend(std::iter::repeat_n(k.value, k.multiplicity));
+    }
+    let ctrl_at = |count: usize| -> Vec<Point3> {
+        (0..count)
+            .map(|i| points[i * points.len() / count.max(1)])
+            .collect()
+    };
+    if closed {
+        let mut tau = flat.clone();
+        tau.push(flat[0] + 1.0);
+        let n = flat.len();
+        Ok(BSplineCurve::try_periodic(p, &tau, ctrl_at(n))?)
+    } else {
+        let mut all = vec![0.0; p + 1];
+        all.extend(flat.iter().filter(|&&v| v > 0.0 && v < 1.0));
+        all.extend(std::iter::repeat_n(1.0, p + 1));
+        let n = all.len() - p - 1;
+        Ok(BSplineCurve::try_new(p, all, ctrl_at(n))?)
+    }
+}
+
+impl Fitter for KnotPlacementFitter {
+    fn step(&mut self) -> Result<FitStatus, FitError> {
+        if self.status != FitStatus::Running {
+            return Ok(self.status);
+        }
+        let start = Instant::now();
+        let cap = self.options.max_iter.unwrap_or(self.data.points.len());
+        let Some(u) = self.next_knot() else {
+            self.status = FitStatus::MaxIterations;
+            return Ok(self.status);
+        };
+        // Knot values live in the curve's domain (a closed curve's period starts at its first
+        // knot), so sorted insertion keeps the seam first.
+        let pos = self.knots.partition_point(|k| k.value < u);
+        self.knots.insert(
+            pos,
+            Knot {
+                value: u,
+                multiplicity: 1,
+            },
+        );
+        let template = template_curve(
+            &self.knots,
+            self.options.degree,
+            self.options.closed,
+            &self.data.points,
+        )?;
+        self.curve = least_squares_curve(&template, &self.data.points, &self.params)?;
+        self.measure();
+        let iter = self.history.len() + 1;
+        self.history.push(IterationRecord {
+            iter,
+            control_points: self.curve.control_points().len(),
+            e_avg_pct: self.stats.e_avg_pct,
+            e_max_pct: self.stats.e_max_pct,
+            e_rms_pct: self.stats.e_rms_pct,
+            ms: start.elapsed().as_secs_f64() * 1e3,
+            refined: true,
+        });
+        self.status = if self.met() {
+            FitStatus::Converged
+        } else if iter >= cap {
+            FitStatus::MaxIterations
+        } else {
+            FitStatus::Running
+        };
+        Ok(self.status)
+    }
+
+    fn history(&self) -> &[IterationRecord] {
+        &self.history
+    }
+
+    fn point_errors(&self) -> &[f64] {
+        &self.errors
+    }
+
+    fn stats(&self) -> ErrorStats {
+        self.stats
+    }
+}
