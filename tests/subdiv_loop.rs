@@ -6,7 +6,9 @@ mod common;
 use common::meshes::{icosahedron, jitter, octahedron, tri_grid};
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::{ControlMesh, PolyMesh};
-use geofit::subdiv::{refine, LimitEval, LimitSurface, LoopSurface, Scheme, SurfaceParam};
+use geofit::subdiv::{
+    refine, refine_levels, LimitEval, LimitSurface, LoopSurface, Scheme, SurfaceParam,
+};
 
 fn loop_surface(mesh: &PolyMesh) -> LoopSurface {
     LoopSurface::try_new(mesh).expect("valid control mesh")
@@ -142,32 +144,132 @@ fn limit_at_control_vertices_equals_limit_masks() {
     }
 }
 
-/// Regular patches are quartic box splines: compare the limit of a regular patch with the
-/// limit-mask positions of the twice-refined mesh at the matching dyadic parameters.
+/// Regular patches are quartic box splines (with reflected phantom points at a straight
+/// boundary): compare the closed form with the limit-mask positions of the twice-refined mesh
+/// at the matching dyadic parameters. Interior vertices of the refined mesh use the interior
+/// limit mask, so this checks the phantom construction off the boundary too.
 #[test]
-fn regular_patch_matches_refined_limit_points() {
+fn regular_and_boundary_patches_match_refined_limit_points() {
     let mesh = jitter(
         &tri_grid(6, |x, y| 0.2 * (x - 3.0).powi(2) - 0.1 * x * y),
         0.05,
         6,
     );
     let s0 = loop_surface(&mesh);
-    let s1 = refined(&mesh);
-    let limits = s1.limit_positions();
-    // Face 2 * (6 * 2 + 2) is an interior, regular patch. Its child corners are refined vertices.
-    let f = 2 * (6 * 2 + 2);
-    for c in 0..4u32 {
-        let child = 4 * f + c;
-        let corners = s1.control_mesh().face_vertices(child).collect::<Vec<_>>();
-        for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].iter().enumerate() {
-            let (pu, pv, _) = to_parent(c as usize, u, v);
-            let a = s0.eval(SurfaceParam {
+    let cm = ControlMesh::try_new(&mesh).unwrap();
+    let twice =
+        LoopSurface::from_control_mesh(refine_levels(Scheme::Loop, &cm, 2).unwrap()).unwrap();
+    let limits = twice.limit_positions();
+    // Face 2 * (6 * 2 + 2) is an interior patch; face 4 has a boundary edge.
+    for f in [2 * (6 * 2 + 2), 4] {
+        for c in 0..4u32 {
+            for g in 0..4u32 {
+                let grandchild = 16 * f + 4 * c + g;
+                let corners = twice
+                    .control_mesh()
+                    .face_vertices(grandchild)
+                    .collect::<Vec<_>>();
+                for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].iter().enumerate() {
+                    let (cu, cv, _) = to_parent(g as usize, u, v);
+                    let (pu, pv, _) = to_parent(c as usize, cu, cv);
+                    let a = s0.eval(SurfaceParam {
+                        patch: f,
+                        u: pu,
+                        v: pv,
+                    });
+                    let b = limits[corners[k] as usize];
+                    assert!(
+                        close(a.point, b, 1e-12),
+                        "face {f} ({pu},{pv}): {:?} vs {b:?}",
+                        a.point
+                    );
+                }
+            }
+        }
+    }
+}
+
+fn bspline(t: f64) -> [f64; 4] {
+    [
+        (1.0 - t).powi(3) / 6.0,
+        (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
+        (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+        t.powi(3) / 6.0,
+    ]
+}
+
+/// A crease tagged along a grid line is the cubic B-spline curve of its vertices, and the
+/// surface stays exact (refinement keeps the limit) on both sides.
+#[test]
+fn crease_limit_curve_is_the_cubic_bspline_of_the_crease() {
+    let n = 6;
+    let mesh = jitter(
+        &tri_grid(n, |x, y| 0.3 * (x * 0.9).sin() + 0.2 * y),
+        0.05,
+        11,
+    );
+    let mut cm = ControlMesh::try_new(&mesh).unwrap();
+    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    for i in 0..n {
+        cm.set_sharp(id(i, 3), id(i + 1, 3), true).unwrap();
+    }
+    let s = LoopSurface::from_control_mesh(cm.clone()).unwrap();
+    let p = |i: usize| mesh.positions()[id(i, 3) as usize];
+    for i in 1..n - 1 {
+        // Face 2 (3 n + i) has edge 0 from (i, 3) to (i + 1, 3).
+        for k in 0..=4 {
+            let t = k as f64 / 4.0;
+            let e = s.eval(SurfaceParam {
+                patch: (2 * (3 * n + i)) as u32,
+                u: t,
+                v: 0.0,
+            });
+            let b = bspline(t);
+            let c: Point3 = (0..4).map(|j| p(i + j - 1) * b[j]).sum();
+            assert!(close(e.point, c, 1e-10), "segment {i} t {t}");
+        }
+    }
+    let s1 = LoopSurface::from_control_mesh(refine(Scheme::Loop, &cm).unwrap()).unwrap();
+    for f in 0..s.num_patches() as u32 {
+        for c in 0..4 {
+            let (pu, pv, _) = to_parent(c, 0.3, 0.2);
+            let a = s.eval(SurfaceParam {
                 patch: f,
                 u: pu,
                 v: pv,
             });
-            assert!(close(a.point, limits[corners[k] as usize], 1e-12));
+            let b = s1.eval(SurfaceParam {
+                patch: 4 * f + c as u32,
+                u: 0.3,
+                v: 0.2,
+            });
+            assert!(close(a.point, b.point, 1e-10), "face {f} child {c}");
         }
+    }
+}
+
+/// Vertices of the k-times refined mesh approach their limit positions like 4^-k (the control
+/// net of a smooth subdivision surface converges quadratically).
+#[test]
+fn refined_vertices_approach_the_limit_at_the_expected_rate() {
+    let mesh = jitter(&icosahedron(), 0.2, 12);
+    let mut cm = ControlMesh::try_new(&mesh).unwrap();
+    let mut errors = Vec::new();
+    for _ in 0..5 {
+        cm = refine(Scheme::Loop, &cm).unwrap();
+        let s = LoopSurface::from_control_mesh(cm.clone()).unwrap();
+        let lim = s.limit_positions();
+        let worst = cm
+            .positions()
+            .iter()
+            .zip(&lim)
+            .map(|(p, q)| (*p - *q).length())
+            .fold(0.0, f64::max);
+        errors.push(worst);
+    }
+    for w in errors.windows(2) {
+        let ratio = w[0] / w[1];
+        assert!(ratio > 3.0 && ratio < 5.0, "ratio {ratio} in {errors:?}");
     }
 }
 

@@ -16,7 +16,7 @@ mod surface;
 mod topo;
 mod walk;
 
-pub use refine::{quadrangulate, refine, refine_levels};
+pub use refine::{limit_positions, quadrangulate, refine, refine_levels};
 pub use surface::{SubdivSurface, Tessellation};
 
 /// Why a subdivision surface could not be built or refined.

@@ -298,9 +298,9 @@ fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
             let valence = if n == 3 { 6 } else { 4 };
             topo.vertex_edges(c).len() == valence && fan.iter().all(|&g| topo.face(g).len() == n)
         }
-        2 if n == 4 => {
+        2 => {
             topo.fan(c, 0, true, &mut fan);
-            fan.len() == 2 && fan.iter().all(|&g| topo.face(g).len() == 4)
+            fan.len() == n - 1 && fan.iter().all(|&g| topo.face(g).len() == n)
         }
         _ => false,
     }
@@ -326,9 +326,33 @@ fn regular_gather(topo: &Topo, scheme: Scheme) -> Option<Vec<f64>> {
     let k = topo.nv;
     match scheme {
         Scheme::Loop => {
+            let sharp: std::collections::HashSet<(u32, u32)> = topo
+                .edges
+                .iter()
+                .zip(&topo.edge_tags)
+                .filter(|(_, t)| t.sharp)
+                .map(|(&[a, b], _)| (a, b))
+                .collect();
+            let is_sharp = |a: u32, b: u32| sharp.contains(&key(a, b));
+            const NBRS: [(i32, i32); 6] = [(1, 0), (0, 1), (-1, 1), (-1, 0), (0, -1), (1, -1)];
             let mut g = vec![0.0; 12 * k];
             for (r, &p) in LOOP_LATTICE.iter().enumerate() {
-                g[r * k + find(p)? as usize] = 1.0;
+                if let Some(i) = find(p) {
+                    g[r * k + i as usize] = 1.0;
+                    continue;
+                }
+                // A phantom point: the half-turn image, about the midpoint of an adjacent
+                // sharp edge, of the real point on the other side.
+                let phantom = (0..6).find_map(|t| {
+                    let (d1, d2) = (NBRS[t], NBRS[(t + 1) % 6]);
+                    let a = find((p.0 + d1.0, p.1 + d1.1))?;
+                    let b = find((p.0 + d2.0, p.1 + d2.1))?;
+                    let c = find((p.0 + d1.0 + d2.0, p.1 + d1.1 + d2.1))?;
+                    is_sharp(a, b).then_some((a, b, c))
+                })?;
+                g[r * k + phantom.0 as usize] += 1.0;
+                g[r * k + phantom.1 as usize] += 1.0;
+                g[r * k + phantom.2 as usize] -= 1.0;
             }
             Some(g)
         }

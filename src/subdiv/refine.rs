@@ -48,6 +48,26 @@ pub fn refine_levels(
     Ok(m)
 }
 
+/// Exact limit positions of the vertices of `mesh` under `scheme` (limit masks), without
+/// building an evaluator. Doo–Sabin is not supported (its limit points are not at vertices).
+pub fn limit_positions(scheme: Scheme, mesh: &ControlMesh) -> Result<Vec<Point3>, SubdivError> {
+    if scheme == Scheme::DooSabin {
+        return Err(SubdivError::Unsupported {
+            what: "Doo–Sabin limit positions",
+        });
+    }
+    let topo = topo_of(mesh);
+    let p = mesh.positions();
+    (0..mesh.num_vertices() as u32)
+        .map(|v| {
+            let s = topo
+                .limit_stencil(scheme, v)
+                .ok_or(SubdivError::Unevaluable { patch: 0 })?;
+            Ok(s.iter().map(|&(i, w)| p[i as usize] * w).sum())
+        })
+        .collect()
+}
+
 /// A quad mesh from any polygon mesh by one Catmull–Clark step (each n-gon gives n quads).
 pub fn quadrangulate(mesh: &ControlMesh) -> Result<ControlMesh, SubdivError> {
     refine(Scheme::CatmullClark, mesh)

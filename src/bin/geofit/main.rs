@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 mod info;
 mod simplify;
+mod subdiv;
 
 #[derive(Parser)]
 #[command(
@@ -24,6 +25,8 @@ enum Command {
     /// Simplify a mesh by quadric error metrics to a target vertex count (the initial control
     /// mesh of a fit), timed, with its distance to the input.
     Simplify(simplify::Args),
+    /// Refine a control mesh with a subdivision scheme (optionally to limit positions).
+    Subdiv(subdiv::Args),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +34,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Info(args) => info::run(args),
         Command::Simplify(args) => simplify::run(args),
+        Command::Subdiv(args) => subdiv::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
