@@ -14,10 +14,12 @@
 //! | [`spline`] | B-spline / NURBS curves and surfaces |
 //! | [`fit`] | the fitting engines (geometric iteration, least squares) |
 //! | [`io`] | readers and writers for point and mesh files |
+//! | [`export`] | IGES and STEP export of B-spline / NURBS curves and surfaces |
 //!
 //! The core is plain Rust with f64 maths and is tested natively with `cargo test`; the renderer
 //! and the wasm bindings sit behind the `wasm32` target.
 
+pub mod export;
 pub mod fit;
 pub mod geom;
 pub mod io;

@@ -3,6 +3,8 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+mod export_samples;
+mod fit_curve;
 mod info;
 mod simplify;
 mod subdiv;
@@ -22,6 +24,12 @@ struct Cli {
 enum Command {
     /// Describe a point or mesh file.
     Info(info::Args),
+    /// Fit a B-spline curve to ordered points (geometric iteration or knot placement) and
+    /// export it as IGES/STEP.
+    FitCurve(fit_curve::Args),
+    /// Write reference curves and surfaces as IGES and STEP with sampled points (for
+    /// interoperability tests).
+    ExportSamples(export_samples::Args),
     /// Simplify a mesh by quadric error metrics to a target vertex count (the initial control
     /// mesh of a fit), timed, with its distance to the input.
     Simplify(simplify::Args),
@@ -33,6 +41,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => info::run(args),
+        Command::FitCurve(args) => fit_curve::run(args),
+        Command::ExportSamples(args) => export_samples::run(args),
         Command::Simplify(args) => simplify::run(args),
         Command::Subdiv(args) => subdiv::run(args),
     };
