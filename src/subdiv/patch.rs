@@ -19,7 +19,7 @@ use crate::geom::{Point3, Vec3};
 use std::collections::HashMap;
 
 /// Most control points one neighbourhood may have (sizes the stack buffers of evaluation).
-pub(crate) const MAX_LOCAL: usize = 96;
+pub(crate) const MAX_LOCAL: usize = 64;
 /// Subdivision depth after which a parameter counts as being at the extraordinary vertex
 /// (sub-patch size 2⁻⁴⁰ of the patch).
 const MAX_DEPTH: usize = 40;
@@ -56,11 +56,69 @@ impl ChildMap {
     }
 }
 
+/// A sparse matrix (rows of weights over local points): subdivision stencils have a handful
+/// of non-zeros per row, so evaluation cost follows the stencil sizes, not `k²`.
+struct Sparse {
+    starts: Vec<u32>,
+    cols: Vec<u16>,
+    vals: Vec<f64>,
+}
+
+impl Sparse {
+    fn from_dense(rows: usize, k: usize, dense: &[f64]) -> Sparse {
+        let mut m = Sparse {
+            starts: vec![0],
+            cols: Vec::new(),
+            vals: Vec::new(),
+        };
+        for r in 0..rows {
+            for (j, &w) in dense[r * k..(r + 1) * k].iter().enumerate() {
+                if w != 0.0 {
+                    m.cols.push(j as u16);
+                    m.vals.push(w);
+                }
+            }
+            m.starts.push(m.cols.len() as u32);
+        }
+        m
+    }
+
+    fn rows(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let (a, b) = (self.starts[r] as usize, self.starts[r + 1] as usize);
+        self.cols[a..b]
+            .iter()
+            .zip(&self.vals[a..b])
+            .map(|(&c, &w)| (c as usize, w))
+    }
+
+    /// `dst[r] = Σ_j m[r][j] src[j]`.
+    fn apply(&self, src: &[Vec3], dst: &mut [Vec3]) {
+        for (r, d) in dst.iter_mut().enumerate().take(self.rows()) {
+            *d = self.row(r).map(|(j, w)| src[j] * w).sum();
+        }
+    }
+
+    /// `out[j] += Σ_r w[r] m[r][j]` (weights pulled back through the matrix).
+    fn pull_back(&self, w: &[f64], out: &mut [f64]) {
+        for (r, &wr) in w.iter().enumerate().take(self.rows()) {
+            if wr != 0.0 {
+                for (j, m) in self.row(r) {
+                    out[j] += wr * m;
+                }
+            }
+        }
+    }
+}
+
 struct Child {
     node: u32,
     k: usize,
-    /// `k × parent k`, row-major: child points from parent points.
-    mat: Vec<f64>,
+    /// `k × parent k`: child points from parent points.
+    mat: Sparse,
     map: ChildMap,
 }
 
@@ -68,7 +126,7 @@ enum Node {
     /// Placeholder while the node is being built.
     Pending,
     /// Closed-form patch: `gather` (`nb × k`) makes the spline's control points.
-    Regular { k: usize, gather: Vec<f64> },
+    Regular { k: usize, gather: Sparse },
     /// Subdivide: one child per sub-patch, and the limit masks of the corners.
     Split {
         k: usize,
@@ -421,7 +479,11 @@ impl Graph {
     fn build(&mut self, topo: &Topo, patch: usize) -> Result<Node, SubdivError> {
         let k = topo.nv;
         if let Some(gather) = regular_gather(topo, self.scheme) {
-            return Ok(Node::Regular { k, gather });
+            let rows = gather.len() / k.max(1);
+            return Ok(Node::Regular {
+                k,
+                gather: Sparse::from_dense(rows, k, &gather),
+            });
         }
         let refined = topo.refine(self.scheme);
         let maps = child_maps(self.scheme);
@@ -442,7 +504,7 @@ impl Graph {
             children.push(Child {
                 node,
                 k: kc,
-                mat,
+                mat: Sparse::from_dense(kc, k, &mat),
                 map,
             });
         }
@@ -466,15 +528,14 @@ impl Graph {
     /// For a regular node whose gather only picks points: the picked local indices in basis
     /// order.
     pub fn direct_picks(&self, node: u32) -> Option<Vec<u32>> {
-        let Node::Regular { k, gather } = &self.nodes[node as usize] else {
+        let Node::Regular { gather, .. } = &self.nodes[node as usize] else {
             return None;
         };
-        gather
-            .chunks(*k)
-            .map(|row| {
-                let mut nz = row.iter().enumerate().filter(|(_, &w)| w != 0.0);
+        (0..gather.rows())
+            .map(|r| {
+                let mut nz = gather.row(r);
                 match (nz.next(), nz.next()) {
-                    (Some((j, &w)), None) if w == 1.0 => Some(j as u32),
+                    (Some((j, w)), None) if w == 1.0 => Some(j as u32),
                     _ => None,
                 }
             })
@@ -536,34 +597,31 @@ impl Graph {
         let mut node = root;
         let mut capped = None;
         for d in 0..path.len {
-            if let (Some((cd, corner)), Node::Split { corner_masks, .. }) =
-                (path.cap, &self.nodes[node as usize])
-            {
-                if cd == d {
-                    capped = Some(
-                        offset
-                            + corner_masks[corner]
-                                .iter()
-                                .map(|&(i, w)| a[i as usize] * w)
-                                .sum::<Vec3>(),
-                    );
-                }
-            }
-            let Node::Split { children, .. } = &self.nodes[node as usize] else {
+            let Node::Split {
+                children,
+                corner_masks,
+                ..
+            } = &self.nodes[node as usize]
+            else {
                 break;
             };
-            let ch = &children[path.steps[d] as usize];
-            for (r, out) in b[..ch.k].iter_mut().enumerate() {
-                let row = &ch.mat[r * k..(r + 1) * k];
-                *out = row.iter().zip(&a[..k]).map(|(&w, &p)| p * w).sum();
+            if let Some((cd, corner)) = path.cap {
+                if cd == d {
+                    let p: Vec3 = corner_masks[corner]
+                        .iter()
+                        .map(|&(i, w)| a[i as usize] * w)
+                        .sum();
+                    capped = Some(offset + p);
+                }
             }
-            std::mem::swap(&mut a, &mut b);
+            let ch = &children[path.steps[d] as usize];
+            ch.mat.apply(&a[..k], &mut b[..ch.k]);
             k = ch.k;
             node = ch.node;
-            let c = a[0];
+            let c = b[0];
             offset += c;
-            for q in &mut a[..k] {
-                *q -= c;
+            for (q, &p) in a[..k].iter_mut().zip(&b[..k]) {
+                *q = p - c;
             }
         }
         let mut out = match &self.nodes[path.leaf as usize] {
@@ -581,16 +639,9 @@ impl Graph {
         out
     }
 
-    fn eval_regular(&self, gather: &[f64], pts: &[Point3], u: f64, v: f64) -> LimitEval {
-        let k = pts.len();
+    fn eval_regular(&self, gather: &Sparse, pts: &[Point3], u: f64, v: f64) -> LimitEval {
         let mut cp = [Vec3::ZERO; 16];
-        for (r, c) in cp.iter_mut().enumerate().take(gather.len() / k.max(1)) {
-            *c = gather[r * k..(r + 1) * k]
-                .iter()
-                .zip(pts)
-                .map(|(&w, &p)| p * w)
-                .sum();
-        }
+        gather.apply(pts, &mut cp);
         match self.scheme {
             Scheme::Loop => combine(&loop_box(u, v), &cp[..12]),
             _ => combine(&bicubic(u, v), &cp[..16]),
@@ -616,23 +667,12 @@ impl Graph {
                     Scheme::Loop => loop_box(path.u, path.v)[0].to_vec(),
                     _ => bicubic(path.u, path.v)[0].to_vec(),
                 };
-                (0..*k)
-                    .map(|j| {
-                        basis
-                            .iter()
-                            .enumerate()
-                            .map(|(r, b)| b * gather[r * k + j])
-                            .sum()
-                    })
-                    .collect()
+                let mut w = vec![0.0; *k];
+                gather.pull_back(&basis, &mut w);
+                w
             }
-            n => {
-                let k = match n {
-                    Node::Split { k, .. } => *k,
-                    _ => 0,
-                };
-                vec![1.0 / k.max(1) as f64; k]
-            }
+            Node::Split { k, .. } => vec![1.0 / (*k).max(1) as f64; *k],
+            Node::Pending => Vec::new(),
         };
         for d in (0..path.len).rev() {
             let Node::Split {
@@ -643,23 +683,14 @@ impl Graph {
             else {
                 continue;
             };
-            if let Some((cd, corner)) = path.cap {
-                if cd == d {
-                    w = vec![0.0; *k];
-                    for &(i, m) in &corner_masks[corner] {
-                        w[i as usize] += m;
-                    }
-                    continue;
-                }
-            }
-            let ch = &children[path.steps[d] as usize];
             let mut up = vec![0.0; *k];
-            for (r, &wr) in w.iter().enumerate() {
-                if wr != 0.0 {
-                    for (j, u) in up.iter_mut().enumerate() {
-                        *u += wr * ch.mat[r * k + j];
+            match path.cap {
+                Some((cd, corner)) if cd == d => {
+                    for &(i, m) in &corner_masks[corner] {
+                        up[i as usize] += m;
                     }
                 }
+                _ => children[path.steps[d] as usize].mat.pull_back(&w, &mut up),
             }
             w = up;
         }
