@@ -76,4 +76,14 @@ fn bun000_range_scan() {
         .map(|t| (p[t[1] as usize] - p[t[0] as usize]).cross(p[t[2] as usize] - p[t[0] as usize]))
         .sum();
     assert!(n.normalize().z > 0.5, "mean normal {n}");
+    // The sample spacing is the scanner's 0.5 mm pitch (obj_info echo_lgincr 0.000500) or a
+    // little more where the surface slopes; a few spacings drop only the silhouette bridges.
+    let spacing = grid.spacing(p).expect("neighbouring samples");
+    assert!((0.0005..0.0008).contains(&spacing), "spacing {spacing}");
+    let kept = grid.triangles_within(p, 4.0 * spacing).len();
+    assert!(
+        kept < tris.len() && kept * 100 > tris.len() * 97,
+        "{kept} of {}",
+        tris.len()
+    );
 }

@@ -88,6 +88,14 @@ fn read_checked(bytes: &[u8], name: Option<&str>) {
     }
 }
 
+/// `$PROPTEST_CASES` when set (for a deeper run), else `default`.
+fn cases(default: u32) -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
 #[derive(Debug, Clone)]
 enum Edit {
     Set(usize, u8),
@@ -168,7 +176,7 @@ fn samples_are_valid() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 2000, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(2000), failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
     fn random_bytes_never_panic(

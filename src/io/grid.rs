@@ -1,5 +1,7 @@
 //! The scanner grid of a raw range scan: which point, if any, each grid cell measured.
 
+use crate::geom::Point3;
+
 /// A `cols × rows` scanner grid (PLY `range_grid`, as written by Cyberware scanners). Cell
 /// `(col, row)` holds the index of the point it measured, or nothing where the laser saw no
 /// surface. Neighbouring cells are neighbouring samples, so the grid triangulates a
@@ -55,6 +57,60 @@ impl RangeGrid {
     }
 }
 
+impl RangeGrid {
+    /// The scan's sample spacing: the median distance between measured cells that are
+    /// neighbours along a row or a column. `None` when no two neighbours were measured (or
+    /// `positions` is not the scan's point list). The natural unit for
+    /// [`RangeGrid::triangles_within`].
+    pub fn spacing(&self, positions: &[Point3]) -> Option<f64> {
+        let mut d = Vec::new();
+        for row in 0..self.rows {
+            for col in 0..self.cols {
+                for (c, r) in [(col + 1, row), (col, row + 1)] {
+                    if let Some(len) = self.edge(positions, (col, row), (c, r)) {
+                        d.push(len);
+                    }
+                }
+            }
+        }
+        if d.is_empty() {
+            return None;
+        }
+        let mid = d.len() / 2;
+        Some(*d.select_nth_unstable_by(mid, f64::total_cmp).1)
+    }
+
+    /// [`RangeGrid::triangles`] without the triangles whose longest edge exceeds `max_edge`.
+    /// At silhouettes and depth jumps neighbouring samples lie on different surfaces, and the
+    /// plain grid triangulation bridges them with long thin triangles; a few times
+    /// [`RangeGrid::spacing`] keeps the surface and drops the bridges. Triangles with an index
+    /// beyond `positions` are dropped too.
+    pub fn triangles_within(&self, positions: &[Point3], max_edge: f64) -> Vec<[u32; 3]> {
+        let max_sq = max_edge * max_edge;
+        let mut out = self.triangles();
+        out.retain(|t| {
+            let corners = t.map(|i| positions.get(i as usize));
+            let [Some(a), Some(b), Some(c)] = corners else {
+                return false;
+            };
+            [
+                a.distance_squared(*b),
+                b.distance_squared(*c),
+                c.distance_squared(*a),
+            ]
+            .iter()
+            .all(|&e| e <= max_sq)
+        });
+        out
+    }
+
+    fn edge(&self, positions: &[Point3], a: (usize, usize), b: (usize, usize)) -> Option<f64> {
+        let pa = positions.get(self.cell(a.0, a.1)? as usize)?;
+        let pb = positions.get(self.cell(b.0, b.1)? as usize)?;
+        Some(pa.distance(*pb))
+    }
+}
+
 /// Corners `a = (col, row)`, `b = (col + 1, row)`, `c = (col, row + 1)`, `d = (col + 1, row + 1)`:
 /// two triangles `a b d`, `a d c`, or the one triangle the three measured corners make, all
 /// counter-clockwise in (col, row).
@@ -89,5 +145,33 @@ mod tests {
         assert_eq!(g.cell(2, 0), None);
         assert_eq!(g.cell(9, 9), None);
         assert!(RangeGrid::try_new(2, 2, vec![None; 3]).is_none());
+    }
+
+    #[test]
+    fn long_edges_over_a_depth_jump_are_dropped() {
+        // 3 × 2 samples one unit apart; the right column lies 10 units deeper.
+        let p = |x: f64, y: f64, z: f64| Point3::new(x, y, z);
+        let positions = vec![
+            p(0.0, 0.0, 0.0),
+            p(1.0, 0.0, 0.0),
+            p(2.0, 0.0, 10.0),
+            p(0.0, 1.0, 0.0),
+            p(1.0, 1.0, 0.0),
+            p(2.0, 1.0, 10.0),
+        ];
+        let g = RangeGrid::try_new(3, 2, (0..6).map(Some).collect()).unwrap();
+        assert_eq!(g.spacing(&positions), Some(1.0));
+        assert_eq!(g.triangles().len(), 4);
+        assert_eq!(
+            g.triangles_within(&positions, 2.0),
+            vec![[0, 1, 4], [0, 4, 3]]
+        );
+        assert!(g.triangles_within(&positions[..2], 100.0).is_empty());
+        assert_eq!(
+            RangeGrid::try_new(1, 1, vec![None])
+                .unwrap()
+                .spacing(&positions),
+            None
+        );
     }
 }
