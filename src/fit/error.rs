@@ -48,4 +48,7 @@ pub enum FitError {
         /// The control point without support.
         index: usize,
     },
+    /// The subdivision library rejected the control mesh.
+    #[error(transparent)]
+    Subdiv(#[from] crate::subdiv::SubdivError),
 }

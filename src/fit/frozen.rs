@@ -64,11 +64,26 @@ impl Stencils {
         }
     }
 
-    /// `steps` steps of Jacobi-preconditioned CG on BᵀB Δ = Bᵀ e (three right-hand sides, one
-    /// per coordinate): the control-point moves that best reduce the error vectors `e` with the
-    /// parameters frozen. Control points no data point depends on do not move.
-    pub(crate) fn cg(&self, e: &[Vec3], steps: usize) -> Vec<Vec3> {
+    /// `steps` steps of Jacobi-preconditioned CG on the frozen-parameter least-squares problem
+    /// min Σ_i r_iᵀ M_i r_i, r_i = e_i − Σ_j B_ij Δ_j, with M_i = n_i n_iᵀ + w (I − n_i n_iᵀ):
+    /// full weight on the distance along the normal n_i, weight `w` = `tangent_weight` on the
+    /// tangential slip that frozen parameters create as the surface moves (w = 1 is the plain
+    /// point-to-point problem; smaller w converges faster, as in squared-distance minimisation).
+    /// Returns the control-point moves Δ; control points no data point depends on stay put.
+    pub(crate) fn cg(
+        &self,
+        e: &[Vec3],
+        normals: &[Vec3],
+        tangent_weight: f64,
+        steps: usize,
+    ) -> Vec<Vec3> {
         let n = self.columns;
+        let metric = |r: &mut [Vec3]| {
+            for (v, nrm) in r.iter_mut().zip(normals) {
+                let along = *nrm * nrm.dot(*v);
+                *v = along + (*v - along) * tangent_weight;
+            }
+        };
         let mut diag = vec![0.0; n];
         for &(j, w) in &self.entries {
             diag[j as usize] += w * w;
@@ -79,47 +94,40 @@ impl Stencils {
             .collect();
         let precondition =
             |r: &[Vec3]| -> Vec<Vec3> { r.iter().zip(&inv).map(|(v, m)| *v * *m).collect() };
-        let dot = |a: &[Vec3], b: &[Vec3]| -> Vec3 { a.iter().zip(b).map(|(x, y)| *x * *y).sum() };
+        let dot = |a: &[Vec3], b: &[Vec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
         let mut x = vec![Vec3::ZERO; n];
         let mut r = vec![Vec3::ZERO; n];
-        self.apply_transposed(e, &mut r);
+        let mut me = e.to_vec();
+        metric(&mut me);
+        self.apply_transposed(&me, &mut r);
         let mut z = precondition(&r);
         let mut p = z.clone();
         let mut rz = dot(&r, &z);
         let (mut bp, mut ap) = (vec![Vec3::ZERO; self.rows()], vec![Vec3::ZERO; n]);
         for _ in 0..steps {
             self.apply(&p, &mut bp);
+            metric(&mut bp);
             self.apply_transposed(&bp, &mut ap);
             let pap = dot(&p, &ap);
-            let alpha = safe_div(rz, pap);
-            if alpha == Vec3::ZERO {
+            let alpha = rz / pap;
+            if !(pap > 0.0 && alpha.is_finite()) {
                 break;
             }
             for k in 0..n {
-                x[k] += alpha * p[k];
-                r[k] -= alpha * ap[k];
+                x[k] += p[k] * alpha;
+                r[k] -= ap[k] * alpha;
             }
             z = precondition(&r);
             let rz_next = dot(&r, &z);
-            let beta = safe_div(rz_next, rz);
+            let beta = rz_next / rz;
+            if !beta.is_finite() {
+                break;
+            }
             rz = rz_next;
             for k in 0..n {
-                p[k] = z[k] + beta * p[k];
+                p[k] = z[k] + p[k] * beta;
             }
         }
         x
     }
-}
-
-/// Componentwise a / b, with 0 where b is 0 or the quotient is not finite.
-fn safe_div(a: Vec3, b: Vec3) -> Vec3 {
-    let f = |a: f64, b: f64| {
-        let q = a / b;
-        if b != 0.0 && q.is_finite() {
-            q
-        } else {
-            0.0
-        }
-    };
-    Vec3::new(f(a.x, b.x), f(a.y, b.y), f(a.z, b.z))
 }

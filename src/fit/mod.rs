@@ -13,6 +13,7 @@ pub mod knot_placement;
 pub mod options;
 pub mod refine;
 pub mod report;
+mod scheme;
 mod stats;
 pub mod subdiv;
 
@@ -23,6 +24,7 @@ pub use error::FitError;
 pub use knot_placement::{KnotPlacementFitter, KnotPlacementOptions};
 pub use options::{Acceleration, SubdivFitOptions, Weighting};
 pub use report::FitReport;
+pub use scheme::surface_of;
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
 pub use subdiv::{ControlSurface, SubdivFitter};
 

@@ -207,10 +207,14 @@ fn move_old_vertices(
     }
 }
 
-/// Loop's original vertex weight for valence `k`.
+/// Loop's vertex weight in Warren's form, 3/16 for valence 3 and 3/(8k) otherwise: the rule the
+/// subdivision library refines and evaluates with, so a split reproduces its limit surface.
 fn loop_beta(k: usize) -> f64 {
-    let c = 0.375 + 0.25 * (2.0 * std::f64::consts::PI / k as f64).cos();
-    (0.625 - c * c) / k as f64
+    if k == 3 {
+        3.0 / 16.0
+    } else {
+        3.0 / (8.0 * k as f64)
+    }
 }
 
 /// Improves a triangle mesh by edge flips: a flip is made when it lowers the valence energy

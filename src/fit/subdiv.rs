@@ -268,7 +268,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let d = match self.options.acceleration {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
-                stencils.cg(&self.error_vectors(), inner)
+                let normals: Vec<Vec3> = self.feet.iter().map(|f| f.normal).collect();
+                stencils.cg(
+                    &self.error_vectors(),
+                    &normals,
+                    self.options.tangent_weight,
+                    inner,
+                )
             }
             _ => self.moves(),
         };
@@ -298,46 +304,43 @@ impl<S: ControlSurface> SubdivFitter<S> {
         false
     }
 
-    /// Faces to split: those holding a point beyond the E_max tolerance, or whose mean distance
-    /// exceeds the E_avg (or E_rms) tolerance; worst first, as many as the budget allows.
+    /// Faces to split, in order: first those holding a point beyond the E_max tolerance (largest
+    /// distance first); then, while E_avg or E_rms misses its tolerance, the faces whose points
+    /// add most to it. As many as the budget and the growth cap of one refinement allow.
     fn faces_to_split(&self) -> Vec<usize> {
         let control = self.control_mesh();
         let nf = control.num_faces();
-        let (mut max, mut sum, mut sum_sq, mut count) = (
-            vec![0.0f64; nf],
-            vec![0.0; nf],
-            vec![0.0; nf],
-            vec![0usize; nf],
-        );
+        let (mut max, mut sum, mut sum_sq) = (vec![0.0f64; nf], vec![0.0; nf], vec![0.0; nf]);
         for (f, d) in self.feet.iter().zip(&self.signed) {
             let face = self.surface.patch_face(f.param.patch);
             if face < nf {
                 max[face] = max[face].max(d.abs());
                 sum[face] += d.abs();
                 sum_sq[face] += d * d;
-                count[face] += 1;
             }
         }
         let t = self.options.tolerances;
-        let abs = |pct: Option<f64>| pct.map(|v| v / 100.0 * self.diagonal);
-        let (tmax, tavg, trms) = (abs(t.max_pct), abs(t.avg_pct), abs(t.rms_pct));
-        let ratio = |value: f64, tol: Option<f64>| tol.map_or(0.0, |t| value / t.max(1e-300));
-        let mut scored: Vec<(f64, usize)> = (0..nf)
-            .filter(|&f| count[f] > 0)
-            .map(|f| {
-                let n = count[f] as f64;
-                let s = ratio(max[f], tmax)
-                    .max(ratio(sum[f] / n, tavg))
-                    .max(ratio((sum_sq[f] / n).sqrt(), trms));
-                (s, f)
-            })
-            .filter(|(s, _)| *s > 1.0)
-            .collect();
-        scored.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let room = self.budget().saturating_sub(self.num_control_points());
+        let tmax = t.max_pct.map(|v| v / 100.0 * self.diagonal);
+        let by = |key: &[f64], keep: &dyn Fn(usize) -> bool| {
+            let mut faces: Vec<usize> = (0..nf).filter(|&f| keep(f)).collect();
+            faces.sort_by(|&a, &b| key[b].total_cmp(&key[a]).then(a.cmp(&b)));
+            faces
+        };
+        let mut order = by(&max, &|f| tmax.is_some_and(|t| max[f] > t));
+        let s = &self.stats;
+        let avg_missed = t.avg_pct.is_some_and(|v| s.e_avg_pct > v);
+        let rms_missed = t.rms_pct.is_some_and(|v| s.e_rms_pct > v);
+        if avg_missed || rms_missed {
+            let key = if avg_missed { &sum } else { &sum_sq };
+            let first: HashSet<usize> = order.iter().copied().collect();
+            order.extend(by(key, &|f| key[f] > 0.0 && !first.contains(&f)));
+        }
+        let current = self.num_control_points();
+        let growth = ((current as f64 * self.options.refine_growth).ceil() as usize).max(32);
+        let room = self.budget().saturating_sub(current).min(growth);
         let mut edges = HashSet::new();
         let mut chosen = Vec::new();
-        for (_, f) in scored {
+        for f in order {
             let face = control.face(f);
             for k in 0..face.len() {
                 let (a, b) = (face[k], face[(k + 1) % face.len()]);
@@ -349,6 +352,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
             chosen.push(f);
         }
         chosen
+    }
+
+    /// Samples per patch edge for the spatial index: about two samples per data point in all,
+    /// at most the option.
+    fn index_resolution(&self) -> usize {
+        let per_patch = 2.0 * self.data.len() as f64 / self.surface.num_patches().max(1) as f64;
+        (per_patch.sqrt().ceil() as usize).clamp(1, self.options.index_resolution)
     }
 
     /// Splits the worst faces within the budget and rebuilds the surface. Returns whether the
@@ -367,7 +377,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                     self.surface.remesh_control(&mut refined)?;
                 }
                 self.surface = self.surface.rebuild(&refined)?;
-                self.index = SurfaceIndex::build(&self.surface, self.options.index_resolution);
+                self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
                 self.accel.reset();
                 self.search_all_feet()?;
                 return Ok(true);

@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 mod export_samples;
 mod fit_curve;
+mod fit;
 mod info;
 mod simplify;
 mod subdiv;
@@ -35,6 +36,8 @@ enum Command {
     Simplify(simplify::Args),
     /// Refine a control mesh with a subdivision scheme (optionally to limit positions).
     Subdiv(subdiv::Args),
+    /// Fit a subdivision surface to a scan by geometric iteration.
+    Fit(fit::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +48,7 @@ fn main() -> ExitCode {
         Command::ExportSamples(args) => export_samples::run(args),
         Command::Simplify(args) => simplify::run(args),
         Command::Subdiv(args) => subdiv::run(args),
+        Command::Fit(args) => fit::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

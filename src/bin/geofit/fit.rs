@@ -1,0 +1,272 @@
+//! `geofit fit FILE --scheme loop|catmull-clark|doo-sabin ...`: fit a subdivision surface to a
+//! scan by geometric iteration, print one line per iteration, optionally write a JSON report,
+//! the control mesh and the limit surface.
+
+use clap::ValueEnum;
+use geofit::fit::{
+    Acceleration, FitReport, FitStatus, Fitter, SubdivFitOptions, SubdivFitter, Tolerances,
+    Weighting,
+};
+use geofit::mesh::PolyMesh;
+use geofit::subdiv::{Scheme, SubdivSurface};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Surface kinds `geofit fit` can produce.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SchemeArg {
+    /// Loop subdivision surface (triangle control mesh).
+    Loop,
+    /// Catmull–Clark subdivision surface (quad control mesh).
+    CatmullClark,
+    /// Doo–Sabin subdivision surface.
+    DooSabin,
+}
+
+/// Error-vector weighting.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum WeightsArg {
+    /// The patent's barycentric / bilinear weights over the 1-ring faces.
+    Patent,
+    /// Basis (limit-stencil) weights of every influencing control point (LSPIA).
+    Basis,
+}
+
+/// Acceleration of the iteration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum AccelArg {
+    /// Plain iteration P ← P + d.
+    None,
+    /// Constant over-relaxation P ← P + 1.5 d.
+    Relax,
+    /// Anderson acceleration over the last 5 iterates.
+    Anderson,
+    /// 8 conjugate-gradient steps per iteration on the frozen foot parameters (basis weights).
+    Cg,
+}
+
+/// Arguments of `geofit fit`.
+#[derive(clap::Args)]
+#[command(after_help = "\
+Without --initial the initial control mesh has n/60 vertices for n data points (at least 50, at \
+most 20,000, and never more than the data mesh has), a density at which QEM keeps the shape of \
+scans like the Stanford bunny (35,947 points -> 599). Tolerances are % of the data's bounding-box \
+diagonal; a fit stops when every tolerance given is met (with none given: --tol-avg 0.01 \
+--tol-max 0.05) or after --max-iter iterations.")]
+pub struct Args {
+    /// Data file (PLY, OBJ, STL, XYZ/CSV/PTS). Every vertex is a data point, also those in no face.
+    file: PathBuf,
+    /// Surface scheme.
+    #[arg(long, value_enum, default_value = "loop")]
+    scheme: SchemeArg,
+    /// Vertex count of the initial control mesh made from the data by QEM simplification.
+    #[arg(long, conflicts_with = "control")]
+    initial: Option<usize>,
+    /// Start from this control mesh instead of simplifying the data.
+    #[arg(long)]
+    control: Option<PathBuf>,
+    /// Tolerance on E_avg, % of the bounding-box diagonal.
+    #[arg(long)]
+    tol_avg: Option<f64>,
+    /// Tolerance on E_max, %.
+    #[arg(long)]
+    tol_max: Option<f64>,
+    /// Tolerance on E_rms, %.
+    #[arg(long)]
+    tol_rms: Option<f64>,
+    /// Iteration cap.
+    #[arg(long, default_value_t = 200)]
+    max_iter: usize,
+    /// Control-point budget for refinement (default: half the number of data points).
+    #[arg(long)]
+    max_control: Option<usize>,
+    /// Never split control faces.
+    #[arg(long)]
+    no_refine: bool,
+    /// Error-vector weighting.
+    #[arg(long, value_enum, default_value = "basis")]
+    weights: WeightsArg,
+    /// Acceleration [default: cg with basis weights, none with patent weights].
+    #[arg(long, value_enum)]
+    accel: Option<AccelArg>,
+    /// With --accel cg: weight of the tangential error relative to the normal one (0, 1].
+    #[arg(long, default_value_t = 0.1)]
+    tangent_weight: f64,
+    /// One refinement adds at most this fraction of the current control points.
+    #[arg(long, default_value_t = 0.5)]
+    refine_growth: f64,
+    /// Write the report (setup, final errors, times, per-iteration history) as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the final control mesh as OBJ.
+    #[arg(long)]
+    cage: Option<PathBuf>,
+    /// Write the limit surface, tessellated, as OBJ.
+    #[arg(long)]
+    limit: Option<PathBuf>,
+    /// Segments per patch edge of the --limit tessellation.
+    #[arg(long, default_value_t = 4)]
+    limit_segments: usize,
+    /// Print only the summary, not one line per iteration.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+impl Args {
+    fn options(&self) -> SubdivFitOptions {
+        let given = self.tol_avg.is_some() || self.tol_max.is_some() || self.tol_rms.is_some();
+        let tolerances = if given {
+            Tolerances {
+                avg_pct: self.tol_avg,
+                max_pct: self.tol_max,
+                rms_pct: self.tol_rms,
+            }
+        } else {
+            Tolerances::default()
+        };
+        let mut options = SubdivFitOptions::default()
+            .with_tolerances(tolerances)
+            .with_max_iter(self.max_iter)
+            .with_max_control(self.max_control)
+            .with_refine(!self.no_refine)
+            .with_weighting(match self.weights {
+                WeightsArg::Patent => Weighting::Patent,
+                WeightsArg::Basis => Weighting::Basis,
+            })
+            .with_acceleration(
+                match self.accel.unwrap_or(match self.weights {
+                    WeightsArg::Basis => AccelArg::Cg,
+                    WeightsArg::Patent => AccelArg::None,
+                }) {
+                    AccelArg::None => Acceleration::None,
+                    AccelArg::Relax => Acceleration::Relax { omega: 1.5 },
+                    AccelArg::Anderson => Acceleration::Anderson { depth: 5 },
+                    AccelArg::Cg => Acceleration::Cg { inner: 8 },
+                },
+            )
+            .with_tangent_weight(self.tangent_weight);
+        options.refine_growth = self.refine_growth;
+        options
+    }
+}
+
+/// The initial control-mesh size chosen from `n` data points (see `--help`).
+pub fn default_initial_count(n: usize, mesh_vertices: usize) -> usize {
+    (n / 60).clamp(50, 20_000).min(mesh_vertices)
+}
+
+fn read(path: &Path) -> Result<PolyMesh, String> {
+    geofit::io::read_path(path)
+        .map(|loaded| loaded.mesh)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+pub fn run(args: Args) -> Result<(), String> {
+    let start = Instant::now();
+    let data = read(&args.file)?;
+    let initial = match &args.control {
+        Some(path) => read(path)?,
+        None => initial_control(&data, args.initial)?,
+    };
+    let scheme = match args.scheme {
+        SchemeArg::Loop => Scheme::Loop,
+        SchemeArg::CatmullClark => Scheme::CatmullClark,
+        SchemeArg::DooSabin => Scheme::DooSabin,
+    };
+    let before_fitter = start.elapsed().as_secs_f64();
+    let fitter =
+        SubdivFitter::<SubdivSurface>::try_new(data.positions(), initial, scheme, args.options())
+            .map_err(|e| e.to_string())?;
+    drive(fitter, before_fitter, &args)
+}
+
+/// The QEM-simplified data mesh with `target` vertices (or the default count).
+fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<PolyMesh, String> {
+    if data.is_point_cloud() {
+        return Err("the data has no faces; give a control mesh with --control".into());
+    }
+    let used = used_vertices(data);
+    let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
+    geofit::mesh::simplify::simplify(data, target).map_err(|e| format!("simplification: {e}"))
+}
+
+fn used_vertices(mesh: &PolyMesh) -> usize {
+    let mut used = vec![false; mesh.num_vertices()];
+    for f in mesh.faces() {
+        for &v in f {
+            used[v as usize] = true;
+        }
+    }
+    used.iter().filter(|&&u| u).count()
+}
+
+/// Iterates to the end, printing progress, then writes the outputs.
+fn drive(
+    mut fitter: SubdivFitter<SubdivSurface>,
+    before_fitter: f64,
+    args: &Args,
+) -> Result<(), String> {
+    let s = fitter.stats();
+    if !args.quiet {
+        println!(
+            "start  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%  ({} points, precompute {:.3} s)",
+            fitter.num_control_points(),
+            s.e_avg_pct,
+            s.e_max_pct,
+            s.e_rms_pct,
+            fitter.data().len(),
+            before_fitter + fitter.precompute_seconds()
+        );
+    }
+    let fit_start = Instant::now();
+    loop {
+        let status = fitter.step().map_err(|e| e.to_string())?;
+        if let (false, Some(r)) = (args.quiet, fitter.history().last()) {
+            println!(
+                "iter {:>3}  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%  {:7.1} ms{}",
+                r.iter,
+                r.control_points,
+                r.e_avg_pct,
+                r.e_max_pct,
+                r.e_rms_pct,
+                r.ms,
+                if r.refined { "  refined" } else { "" }
+            );
+        }
+        if status != FitStatus::Running {
+            break;
+        }
+    }
+    let report = FitReport::of(&fitter, before_fitter, fit_start.elapsed().as_secs_f64());
+    println!(
+        "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%, precompute {:.2} s, fit {:.2} s, total {:.2} s",
+        report.scheme,
+        if report.converged { "converged" } else { "stopped" },
+        report.iterations,
+        report.initial_control_points,
+        report.final_control_points,
+        report.e_avg_pct,
+        report.e_max_pct,
+        report.e_rms_pct,
+        report.precompute_s,
+        report.fit_s,
+        report.total_s
+    );
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if let Some(path) = &args.cage {
+        write_obj(path, &fitter.control_mesh())?;
+    }
+    if let Some(path) = &args.limit {
+        write_obj(path, &fitter.limit_mesh(args.limit_segments))?;
+    }
+    Ok(())
+}
+
+fn write_obj(path: &Path, mesh: &PolyMesh) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut out = std::io::BufWriter::new(file);
+    geofit::io::write_obj(mesh, &mut out).map_err(|e| format!("{}: {e}", path.display()))
+}

@@ -1,0 +1,86 @@
+//! The fitter's view of the subdivision library: [`SubdivSurface`] as a [`ControlSurface`],
+//! with each scheme's refinement and remeshing.
+
+use super::refine::{improve_by_flips, split_triangles, SplitRule};
+use super::subdiv::{ControlSurface, SubdivFitter};
+use super::{FitError, SubdivFitOptions};
+use crate::geom::Point3;
+use crate::mesh::{ControlMesh, PolyMesh};
+use crate::subdiv::{quadrangulate, refine, Scheme, SubdivSurface};
+
+/// The limit surface of `control` under `scheme`; quad schemes accept any polygon mesh and turn
+/// it into quads first (one Catmull–Clark step) when it is not all quads.
+pub fn surface_of(scheme: Scheme, control: &PolyMesh) -> Result<SubdivSurface, FitError> {
+    let mesh = ControlMesh::try_new(control).map_err(|e| FitError::ControlMesh {
+        reason: e.to_string(),
+    })?;
+    let mesh = match scheme {
+        Scheme::Loop => mesh,
+        _ if mesh.is_quad_mesh() => mesh,
+        _ => quadrangulate(&mesh)?,
+    };
+    Ok(SubdivSurface::try_new(scheme, mesh)?)
+}
+
+impl ControlSurface for SubdivSurface {
+    fn scheme_name(&self) -> &'static str {
+        match self.scheme() {
+            Scheme::Loop => "loop",
+            Scheme::CatmullClark => "catmull-clark",
+            Scheme::DooSabin => "doo-sabin",
+        }
+    }
+
+    fn control_polygons(&self) -> PolyMesh {
+        self.control_mesh().to_poly_mesh().unwrap_or_default()
+    }
+
+    fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError> {
+        surface_of(self.scheme(), control)
+    }
+
+    fn patch_face(&self, patch: u32) -> usize {
+        patch as usize
+    }
+
+    /// Loop: red–green splitting with Loop's masks. Quad schemes: one refinement step of the
+    /// whole mesh (it reproduces the limit surface exactly; local conforming quad refinement is
+    /// not implemented), made only when it fits the caller's budget.
+    fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
+        match self.scheme() {
+            Scheme::Loop => split_triangles(control, marked, SplitRule::Loop),
+            scheme => {
+                let mesh = ControlMesh::try_new(control).map_err(|e| FitError::ControlMesh {
+                    reason: e.to_string(),
+                })?;
+                refine(scheme, &mesh)?
+                    .to_poly_mesh()
+                    .map_err(|e| FitError::ControlMesh {
+                        reason: e.to_string(),
+                    })
+            }
+        }
+    }
+
+    fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
+        match self.scheme() {
+            Scheme::Loop => improve_by_flips(control, 3),
+            _ => Ok(0),
+        }
+    }
+}
+
+impl SubdivFitter<SubdivSurface> {
+    /// A fitter of `data_points` (connectivity not needed) by the limit surface of `scheme`,
+    /// starting from `initial_control` (triangles for Loop; any polygons for the quad schemes,
+    /// which are turned into quads when needed).
+    pub fn try_new(
+        data_points: &[Point3],
+        initial_control: PolyMesh,
+        scheme: Scheme,
+        options: SubdivFitOptions,
+    ) -> Result<Self, FitError> {
+        let surface = surface_of(scheme, &initial_control)?;
+        SubdivFitter::with_surface(data_points, surface, options)
+    }
+}

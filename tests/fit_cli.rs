@@ -1,0 +1,122 @@
+//! `geofit fit` end to end on a small shared scan (spot.obj, 2,930 points): progress lines, the
+//! JSON report's fields, the cage and limit OBJ files, and clear errors for bad options.
+
+mod common;
+
+use common::data_file;
+use std::process::Command;
+
+fn geofit(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_geofit"))
+        .args(args)
+        .output()
+        .expect("the geofit binary runs")
+}
+
+#[test]
+fn fit_writes_report_cage_and_limit() {
+    let dir = std::env::temp_dir().join(format!("geofit-fit-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let (json, cage, limit) = (
+        dir.join("r.json"),
+        dir.join("cage.obj"),
+        dir.join("limit.obj"),
+    );
+    let spot = data_file("spot.obj");
+    let out = geofit(&[
+        "fit",
+        spot.to_str().expect("utf-8 path"),
+        "--scheme",
+        "loop",
+        "--initial",
+        "150",
+        "--tol-avg",
+        "0.2",
+        "--max-iter",
+        "8",
+        "--max-control",
+        "400",
+        "--json",
+        json.to_str().expect("utf-8"),
+        "--cage",
+        cage.to_str().expect("utf-8"),
+        "--limit",
+        limit.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.lines().any(|l| l.starts_with("iter   1")),
+        "{stdout}"
+    );
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("report")).expect("JSON");
+    for key in [
+        "scheme",
+        "points",
+        "initial_control_points",
+        "final_control_points",
+        "iterations",
+        "e_avg_pct",
+        "e_max_pct",
+        "e_rms_pct",
+        "precompute_s",
+        "fit_s",
+        "total_s",
+        "history",
+    ] {
+        assert!(report.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(report["scheme"], "loop");
+    assert_eq!(report["points"], 2930);
+    let history = report["history"].as_array().expect("history");
+    assert_eq!(
+        history.len() as u64,
+        report["iterations"].as_u64().expect("count")
+    );
+    for key in [
+        "iter",
+        "control_points",
+        "e_avg_pct",
+        "e_max_pct",
+        "e_rms_pct",
+        "ms",
+    ] {
+        assert!(history[0].get(key).is_some(), "history lacks {key}");
+    }
+    let first = history[0]["e_avg_pct"].as_f64().expect("number");
+    assert!(report["e_avg_pct"].as_f64().expect("number") <= first);
+    let cage_mesh = geofit::io::read_path(&cage).expect("cage OBJ").mesh;
+    assert_eq!(
+        cage_mesh.num_vertices() as u64,
+        report["final_control_points"].as_u64().expect("count")
+    );
+    assert!(
+        geofit::io::read_path(&limit)
+            .expect("limit OBJ")
+            .mesh
+            .num_faces()
+            > 0
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_options_fail_with_a_message() {
+    let spot = data_file("spot.obj");
+    let spot = spot.to_str().expect("utf-8");
+    for args in [
+        vec!["fit", spot, "--tol-max=-1"],
+        vec!["fit", spot, "--weights", "patent", "--accel", "cg"],
+        vec!["fit", "/nonexistent/file.obj"],
+    ] {
+        let out = geofit(&args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.starts_with("geofit: "), "{args:?}: {err}");
+    }
+}
