@@ -16,7 +16,14 @@ fn fit_curve_reports_and_exports() {
         let out = Command::new(env!("CARGO_BIN_EXE_geofit"))
             .arg("fit-curve")
             .arg(repo().join("tests/data/fandisk_section_x.xyz"))
-            .args(["--closed", "--method", method, "--tol-max", "0.01", "--json"])
+            .args([
+                "--closed",
+                "--method",
+                method,
+                "--tol-max",
+                "0.01",
+                "--json",
+            ])
             .arg(&json)
             .arg("--iges")
             .arg(dir.join(format!("{method}.igs")))
@@ -24,7 +31,11 @@ fn fit_curve_reports_and_exports() {
             .arg(dir.join(format!("{method}.stp")))
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let r: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
         assert_eq!(r["converged"], true, "{method}");

@@ -366,65 +366,41 @@ impl KnotPlacementFitter {
     fn next_knot(&self) -> Option<f64> {
         let mut order: Vec<usize> = (0..self.errors.len()).collect();
         order.sort_by(|&a, &b| self.errors[b].abs().total_cmp(&self.errors[a].abs()));
+        let mut sorted: Vec<f64> = self
+            .params
+            .iter()
+            .map(|&t| self.curve.normalize_param(t))
+            .collect();
+        sorted.sort_by(f64::total_cmp);
         order
             .into_iter()
             .map(|i| self.curve.normalize_param(self.params[i]))
-            .find(|&u| self.admissible(u))
+            .find(|&u| self.admissible(u, &sorted))
     }
 
     /// Whether a single knot at `u` keeps ≥ 1 data point to each neighbouring knot (2 to a
     /// multiple knot). A point exactly at a knot counts for the span on its left, so knots at
-    /// the foot points of consecutive data points remain possible.
-    fn admissible(&self, u: f64) -> bool {
+    /// the foot points of consecutive data points remain possible. `sorted` holds the data
+    /// parameters in the domain, sorted; the knots are sorted too (a closed curve's period
+    /// starts at its first knot), so both lookups are binary searches.
+    fn admissible(&self, u: f64, sorted: &[f64]) -> bool {
         let (a, b) = self.curve.domain();
-        let period = b - a;
-        let wrap = |x: f64| {
-            if self.options.closed {
-                a + (x - a).rem_euclid(period)
-            } else {
-                x
-            }
-        };
-        let mut left = Knot {
-            value: a,
-            multiplicity: 1,
-        };
-        let mut right = Knot {
-            value: b,
-            multiplicity: 1,
-        };
-        for k in &self.knots {
-            let v = wrap(k.value);
-            if v == u {
-                return false;
-            }
-            if v < u && v >= left.value {
-                left = Knot { value: v, ..*k };
-            }
-            if v > u && v <= right.value {
-                right = Knot { value: v, ..*k };
-            }
+        let k = self.knots.partition_point(|k| k.value < u);
+        if self.knots.get(k).is_some_and(|n| n.value == u) {
+            return false;
         }
-        if self.options.closed {
-            // The seam knot bounds both ends of the domain.
-            if let Some(seam) = self.knots.iter().find(|k| wrap(k.value) == a) {
-                if left.value == a {
-                    left.multiplicity = seam.multiplicity;
-                }
-                if right.value == b {
-                    right.multiplicity = seam.multiplicity;
-                }
-            }
-        }
+        let seam = |end: f64| Knot {
+            value: end,
+            multiplicity: match self.knots.first() {
+                Some(f) if self.options.closed && f.value == a => f.multiplicity,
+                _ => 1,
+            },
+        };
+        let left = k.checked_sub(1).map_or(seam(a), |i| self.knots[i]);
+        let right = self.knots.get(k).copied().unwrap_or(seam(b));
         let need = |k: &Knot| if k.multiplicity > 1 { 2 } else { 1 };
-        let count = |lo: f64, hi: f64| {
-            self.params
-                .iter()
-                .map(|&t| self.curve.normalize_param(t))
-                .filter(|&t| t > lo && t <= hi)
-                .count()
-        };
-        count(left.value, u) >= need(&left) && count(u, right.value) >= need(&right)
+        let upto = |x: f64| sorted.partition_point(|&t| t <= x);
+        upto(u) - upto(left.value) >= need(&left) && upto(right.value) - upto(u) >= need(&right)
     }
 }
 

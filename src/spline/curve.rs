@@ -276,10 +276,10 @@ impl BSplineCurve {
 
     /// The foot point of `p` on the curve by Newton's method on (C(u) − p)·C'(u) = 0, started at
     /// `u0`. Each step is damped until the distance does not grow; the parameter is wrapped
-    /// (closed) or clamped (open) into the domain.
+    /// (closed) or clamped (open) into the domain. Converged when a step moves the foot point
+    /// by less than 1e-12 of the curve's extent (|C'|·period) plus 1e-9 of the distance.
     pub fn closest_point_from(&self, p: Point3, u0: f64, max_iter: usize) -> CurveNearest {
         let (a, b) = self.domain();
-        let eps = 1e-14 * (b - a);
         let mut u = self.normalize_param(u0);
         let mut c = self.eval_derivs(u, 2);
         let mut dist_sq = (c[0] - p).length_squared();
@@ -293,19 +293,22 @@ impl BSplineCurve {
             if denom.is_nan() || denom <= 0.0 {
                 return self.nearest(u, c[0], dist_sq, it, true);
             }
-            let mut du = -f / denom;
-            du = du.clamp(-0.25 * (b - a), 0.25 * (b - a));
+            let speed = g.sqrt();
+            let tol = 1e-12 * (b - a) + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
+            let mut du = (-f / denom).clamp(-0.25 * (b - a), 0.25 * (b - a));
+            if du.abs() <= tol {
+                return self.nearest(u, c[0], dist_sq, it, true);
+            }
             let mut accepted = false;
             for _ in 0..8 {
                 let un = self.normalize_param(u + du);
                 let cn = self.eval_derivs(un, 2);
                 let dn = (cn[0] - p).length_squared();
                 if dn <= dist_sq {
-                    let moved = (un - u).abs();
+                    accepted = (un - u).abs() > tol;
                     u = un;
                     c = cn;
                     dist_sq = dn;
-                    accepted = moved > eps;
                     break;
                 }
                 du *= 0.5;

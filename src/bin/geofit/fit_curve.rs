@@ -157,8 +157,14 @@ pub fn run(args: Args) -> Result<(), String> {
         }
     };
     let fit_s = start.elapsed().as_secs_f64();
+    let desc = CurveDesc::from_curve(&curve).map_err(|e| e.to_string())?;
+    let clamped = serde_json::json!({
+        "degree": desc.degree,
+        "knots": desc.knots,
+        "control_points": desc.control_points.iter().map(|p| p.to_array()).collect::<Vec<_>>(),
+    });
     let model = ExportModel {
-        curves: vec![CurveDesc::from_curve(&curve).map_err(|e| e.to_string())?],
+        curves: vec![desc],
         surfaces: Vec::new(),
     };
     write_exports(&model, args.iges.as_deref(), args.step.as_deref())?;
@@ -182,6 +188,7 @@ pub fn run(args: Args) -> Result<(), String> {
         "history": history,
         "domain": [curve.domain().0, curve.domain().1],
         "samples": curve_samples(&curve, 101),
+        "clamped": clamped,
     });
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
     match &args.json {
