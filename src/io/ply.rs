@@ -68,14 +68,14 @@ fn read_body<B: Body>(mut body: B, header: &Header) -> Result<LoadedFile, ReadEr
             "face" => read_lists(&mut body, el, &mut p, push_face)?,
             "tristrips" => read_lists(&mut body, el, &mut p, push_strip)?,
             "range_grid" => read_lists(&mut body, el, &mut p, push_grid_cell)?,
-            _ => read_elements(&mut body, el, &[], |_, _, _| Ok(()))?,
+            _ => read_elements(&mut body, el, &[], |_, _| Ok(()))?,
         }
     }
     finish(p, header, has_z)
 }
 
-fn finish(p: Parsed, header: &Header, has_z: bool) -> Result<LoadedFile, ReadError> {
-    let range_grid = grid(&p, header)?;
+fn finish(mut p: Parsed, header: &Header, has_z: bool) -> Result<LoadedFile, ReadError> {
+    let range_grid = grid(std::mem::take(&mut p.grid_cells), header)?;
     let faces = p
         .face_starts
         .windows(2)
@@ -89,14 +89,14 @@ fn finish(p: Parsed, header: &Header, has_z: bool) -> Result<LoadedFile, ReadErr
 }
 
 /// The range grid, when the file has a `range_grid` element and `obj_info` gives its size.
-fn grid(p: &Parsed, header: &Header) -> Result<Option<RangeGrid>, ReadError> {
+fn grid(cells: Vec<Option<u32>>, header: &Header) -> Result<Option<RangeGrid>, ReadError> {
     let Some(el) = header.element("range_grid") else {
         return Ok(None);
     };
     let (Some(cols), Some(rows)) = (header.num_cols, header.num_rows) else {
         return Ok(None);
     };
-    RangeGrid::try_new(cols, rows, p.grid_cells.clone())
+    RangeGrid::try_new(cols, rows, cells)
         .map(Some)
         .ok_or_else(|| ReadError::Syntax {
             format: PLY,
@@ -130,13 +130,13 @@ fn check_room<B: Body>(body: &mut B, el: &Element) -> Result<(), ReadError> {
 }
 
 /// Reads every item of `el`, filling `slots` (x/y/z coordinates and one index list) and
-/// handing them to `take` with the item's number and location. Properties without a slot are
+/// handing them to `take` with the item's location. Properties without a slot are
 /// skipped by type.
 fn read_elements<B: Body>(
     body: &mut B,
     el: &Element,
     slots: &[Slot],
-    mut take: impl FnMut(&Item, usize, Location) -> Result<(), ReadError>,
+    mut take: impl FnMut(&Item, Location) -> Result<(), ReadError>,
 ) -> Result<(), ReadError> {
     if el.props.is_empty() {
         return Ok(());
@@ -144,9 +144,10 @@ fn read_elements<B: Body>(
     let mut item = Item::default();
     for i in 0..el.count {
         let at = body.at();
-        read_item(body, el, slots, &mut item)
-            .map_err(|(prop, fault)| fault_error(fault, body.at(), el, i, &el.props[prop].name))?;
-        take(&item, i, at)?;
+        read_item(body, el, slots, &mut item).map_err(|(prop, fault)| {
+            fault_error(fault, body.fault_at(), el, i, &el.props[prop].name)
+        })?;
+        take(&item, at)?;
     }
     Ok(())
 }
@@ -211,7 +212,12 @@ fn fault_error(fault: Fault, at: Location, el: &Element, i: usize, prop: &str) -
         Fault::NotInteger(token) => ReadError::Syntax {
             format: PLY,
             at,
-            message: format!("expected a non-negative integer for {what}, found '{token}'"),
+            message: format!("expected an integer for {what}, found '{token}'"),
+        },
+        Fault::NegativeLength(n) => ReadError::Syntax {
+            format: PLY,
+            at,
+            message: format!("list length {n} is negative in {what}"),
         },
     }
 }
@@ -235,7 +241,7 @@ fn read_vertices<B: Body>(body: &mut B, el: &Element, p: &mut Parsed) -> Result<
         }
     }
     p.positions.reserve(el.count);
-    read_elements(body, el, &slots, |item, _, at| {
+    read_elements(body, el, &slots, |item, at| {
         if item.xyz.iter().all(|c| c.is_finite()) {
             p.positions.push(Point3::from_array(item.xyz));
             Ok(())
@@ -269,7 +275,7 @@ fn read_lists<B: Body>(
         })?;
     let mut slots = vec![Slot::Skip; el.props.len()];
     slots[list] = Slot::Indices;
-    read_elements(body, el, &slots, |item, _, at| push(p, &item.list, at))
+    read_elements(body, el, &slots, |item, at| push(p, &item.list, at))
 }
 
 /// Checks a vertex index against the header's vertex count.
@@ -380,6 +386,8 @@ mod tests {
             e.to_string(),
             "PLY line 10: expected a number for property 'y' of vertex 1 (of 3), found 'x'"
         );
+        let e = read(&ascii(TRI, "0 0 0\n1 0 x\n0 1 0\n")).unwrap_err();
+        assert!(e.to_string().starts_with("PLY line 10: "), "{e}");
         let e = read(&ascii(TRI, "0 0 0\n1 0 0\n")).unwrap_err();
         assert!(matches!(e, ReadError::Truncated { .. }), "{e}");
         let src = ascii(
@@ -389,6 +397,14 @@ mod tests {
         assert_eq!(
             read(&src).unwrap_err().to_string(),
             "PLY line 14: vertex index 3 is out of range (the file has 3 vertices)"
+        );
+        let src = ascii(
+            &format!("{TRI}element face 1\nproperty list char int vertex_indices\n"),
+            "0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n",
+        );
+        assert_eq!(
+            read(&src).unwrap_err().to_string(),
+            "PLY line 14: list length -3 is negative in property 'vertex_indices' of face 0 (of 1)"
         );
         let e = read(&ascii(TRI, "0 0 0\n1 inf 0\n0 1 0\n")).unwrap_err();
         assert_eq!(

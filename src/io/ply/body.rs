@@ -14,6 +14,8 @@ pub enum Fault {
     NotNumber(String),
     /// A value that should be a count or index but is not a whole number in range.
     NotInteger(String),
+    /// A list length below zero.
+    NegativeLength(i64),
 }
 
 /// A reader of typed values from a PLY body.
@@ -26,6 +28,8 @@ pub trait Body {
     fn skip(&mut self, t: Scalar, n: usize) -> Result<(), Fault>;
     /// Where the next value starts.
     fn at(&mut self) -> Location;
+    /// Where the value last read, or tried, starts: the place to blame for a fault.
+    fn fault_at(&self) -> Location;
     /// Bytes left in the body.
     fn remaining(&self) -> usize;
     /// The fewest bytes one item of `el` can take, so that a header count can be checked
@@ -35,7 +39,7 @@ pub trait Body {
     /// The next list length: a non-negative integer.
     fn length(&mut self, t: Scalar) -> Result<usize, Fault> {
         let n = self.integer(t)?;
-        usize::try_from(n).map_err(|_| Fault::NotInteger(n.to_string()))
+        usize::try_from(n).map_err(|_| Fault::NegativeLength(n))
     }
 }
 
@@ -45,6 +49,7 @@ pub struct Ascii<'a> {
     bytes: &'a [u8],
     pos: usize,
     line: usize,
+    token_line: usize,
 }
 
 impl<'a> Ascii<'a> {
@@ -54,6 +59,7 @@ impl<'a> Ascii<'a> {
             bytes,
             pos: 0,
             line,
+            token_line: line,
         }
     }
 
@@ -69,6 +75,7 @@ impl<'a> Ascii<'a> {
 
     fn token(&mut self) -> Result<&'a [u8], Fault> {
         self.skip_space();
+        self.token_line = self.line;
         let start = self.pos;
         let len = self.bytes[start..]
             .iter()
@@ -105,6 +112,10 @@ impl Body for Ascii<'_> {
         Location::Line(self.line)
     }
 
+    fn fault_at(&self) -> Location {
+        Location::Line(self.token_line)
+    }
+
     fn remaining(&self) -> usize {
         self.bytes.len() - self.pos
     }
@@ -120,15 +131,21 @@ impl Body for Ascii<'_> {
 pub struct Binary<'a, const BIG: bool> {
     bytes: &'a [u8],
     pos: usize,
+    last: usize,
 }
 
 impl<'a, const BIG: bool> Binary<'a, BIG> {
     /// `bytes` is the whole file; the body starts at `start`.
     pub fn new(bytes: &'a [u8], start: usize) -> Binary<'a, BIG> {
-        Binary { bytes, pos: start }
+        Binary {
+            bytes,
+            pos: start,
+            last: start,
+        }
     }
 
     fn take<const N: usize>(&mut self) -> Result<[u8; N], Fault> {
+        self.last = self.pos;
         let chunk = self
             .bytes
             .get(self.pos..self.pos.saturating_add(N))
@@ -185,6 +202,7 @@ impl<const BIG: bool> Body for Binary<'_, BIG> {
     }
 
     fn skip(&mut self, t: Scalar, n: usize) -> Result<(), Fault> {
+        self.last = self.pos;
         let end = n
             .checked_mul(t.size())
             .and_then(|len| self.pos.checked_add(len))
@@ -196,6 +214,10 @@ impl<const BIG: bool> Body for Binary<'_, BIG> {
 
     fn at(&mut self) -> Location {
         Location::Byte(self.pos)
+    }
+
+    fn fault_at(&self) -> Location {
+        Location::Byte(self.last)
     }
 
     fn remaining(&self) -> usize {
