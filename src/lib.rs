@@ -9,6 +9,7 @@
 //! | module | what it is |
 //! |---|---|
 //! | [`geom`] | f64 points, vectors, boxes, tolerances |
+//! | [`cloud`] | bare point clouds to meshes (range grid, Delaunay, implicit surface) |
 //! | [`mesh`] | polygon meshes, adjacency, validation, simplification |
 //! | [`subdiv`] | subdivision schemes and exact limit-surface evaluation |
 //! | [`spline`] | B-spline / NURBS curves and surfaces |
@@ -19,6 +20,7 @@
 //! The core is plain Rust with f64 maths and is tested natively with `cargo test`; the renderer
 //! and the wasm bindings sit behind the `wasm32` target.
 
+pub mod cloud;
 pub mod export;
 pub mod fit;
 pub mod geom;

@@ -1,0 +1,325 @@
+//! From bare points to a mesh: what a scan without connectivity needs before QEM simplification
+//! and fitting (SPEC §1, steps 1–2).
+//!
+//! Two kinds of data, told apart automatically (or forced with
+//! [`ReconstructOptions::with_kind`]):
+//!
+//! - **Open** single-view scans (height-field-like, e.g. one range image): triangulated by the
+//!   scanner's range grid when the file has one, else by a 2D Delaunay triangulation of the
+//!   points projected onto their best-fit plane; triangles that span holes or run outside the
+//!   scanned outline (an edge longer than [`ReconstructOptions::long_edge_factor`] times the
+//!   local point spacing) are cut away. The mesh's vertices are the input points themselves.
+//! - **Closed** objects (points all around): normals by PCA over the k nearest neighbours,
+//!   oriented consistently along a minimum spanning tree (Hoppe et al. 1992), then the zero set
+//!   of an implicit moving-least-squares signed distance contoured by marching tetrahedra: a
+//!   watertight manifold wherever the sampling is closed. Its vertices are new points.
+//!
+//! Either way the result is one manifold, consistently oriented piece; for fitting, keep the
+//! input points as the data and use the mesh only to start from (e.g. through
+//! [`crate::mesh::simplify`]).
+//!
+//! ```
+//! use geofit::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
+//! use geofit::geom::Point3;
+//!
+//! // A 20×20 height field (a shallow bowl): an open scan.
+//! let points: Vec<Point3> = (0..400)
+//!     .map(|k| {
+//!         let (x, y) = ((k % 20) as f64, (k / 20) as f64);
+//!         Point3::new(x, y, 0.02 * ((x - 9.5).powi(2) + (y - 9.5).powi(2)))
+//!     })
+//!     .collect();
+//! let out = reconstruct(&points, None, &ReconstructOptions::default())?;
+//! assert_eq!(out.kind, SurfaceKind::Open);
+//! assert_eq!(out.mesh.num_triangles(), 2 * 19 * 19);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod cleanup;
+mod closed;
+mod eigen;
+mod error;
+mod neighbours;
+mod normals;
+mod open;
+
+pub use error::ReconstructError;
+
+use crate::geom::Point3;
+use crate::io::RangeGrid;
+use crate::mesh::PolyMesh;
+use neighbours::{median, Neighbours};
+
+/// Which kind of surface the points sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum SurfaceKind {
+    /// A single-view, height-field-like scan with an outline.
+    Open,
+    /// An object sampled all around.
+    Closed,
+}
+
+/// Settings of [`reconstruct`]. Build with `ReconstructOptions::default()` and the `with_*`
+/// setters.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct ReconstructOptions {
+    /// Force open or closed; `None` (default) decides from the data: a range grid means open;
+    /// otherwise the points are open when at least 90 % of their oriented normals face the
+    /// same side of the best-fit plane.
+    pub kind: Option<SurfaceKind>,
+    /// Neighbours per point for normals and spacing. Default 12.
+    pub neighbours: usize,
+    /// Open scans: triangles with an edge longer than this times the local spacing (mean
+    /// distance of a point to its 6 nearest neighbours) are cut. Default 3.
+    pub long_edge_factor: f64,
+    /// Closed objects: contour grid cell size in units of the median point spacing. Default 2:
+    /// finer costs time and gains nothing once QEM simplifies the result.
+    pub cell_size: f64,
+    /// Statistical outlier removal: drop points whose mean distance to their neighbours exceeds
+    /// the mean over all points by this many standard deviations. Default `None` (off).
+    pub outlier_std_ratio: Option<f64>,
+}
+
+impl Default for ReconstructOptions {
+    fn default() -> ReconstructOptions {
+        ReconstructOptions {
+            kind: None,
+            neighbours: 12,
+            long_edge_factor: 3.0,
+            cell_size: 2.0,
+            outlier_std_ratio: None,
+        }
+    }
+}
+
+impl ReconstructOptions {
+    /// Sets [`ReconstructOptions::kind`].
+    pub fn with_kind(mut self, kind: Option<SurfaceKind>) -> ReconstructOptions {
+        self.kind = kind;
+        self
+    }
+    /// Sets [`ReconstructOptions::neighbours`].
+    pub fn with_neighbours(mut self, k: usize) -> ReconstructOptions {
+        self.neighbours = k;
+        self
+    }
+    /// Sets [`ReconstructOptions::long_edge_factor`].
+    pub fn with_long_edge_factor(mut self, factor: f64) -> ReconstructOptions {
+        self.long_edge_factor = factor;
+        self
+    }
+    /// Sets [`ReconstructOptions::cell_size`].
+    pub fn with_cell_size(mut self, spacings: f64) -> ReconstructOptions {
+        self.cell_size = spacings;
+        self
+    }
+    /// Sets [`ReconstructOptions::outlier_std_ratio`].
+    pub fn with_outlier_std_ratio(mut self, ratio: Option<f64>) -> ReconstructOptions {
+        self.outlier_std_ratio = ratio;
+        self
+    }
+
+    fn validate(&self) -> Result<(), ReconstructError> {
+        let bad = |name, value: f64, expected| {
+            Err(ReconstructError::InvalidOption {
+                name,
+                value,
+                expected,
+            })
+        };
+        if !(3..=64).contains(&self.neighbours) {
+            return bad("neighbours", self.neighbours as f64, "3 to 64");
+        }
+        let f = self.long_edge_factor;
+        if !(f.is_finite() && f > 0.0) {
+            return bad("long_edge_factor", f, "finite and > 0");
+        }
+        let c = self.cell_size;
+        if !(c.is_finite() && (0.25..=64.0).contains(&c)) {
+            return bad("cell_size", c, "0.25 to 64");
+        }
+        match self.outlier_std_ratio {
+            Some(r) if !(r.is_finite() && r > 0.0) => bad("outlier_std_ratio", r, "finite and > 0"),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A mesh built from points.
+#[derive(Clone, Debug)]
+pub struct Reconstruction {
+    /// The surface: for open scans over the input points (same indices; points cut away or
+    /// removed as outliers are in no face), for closed objects over new contour vertices.
+    pub mesh: PolyMesh,
+    /// Which kind the points were taken for.
+    pub kind: SurfaceKind,
+    /// Points removed as outliers.
+    pub outliers: usize,
+}
+
+/// Neighbours for spacing estimates and the outlier test.
+const SPACING_NEIGHBOURS: usize = 6;
+/// Fewest points that span a surface.
+const MIN_POINTS: usize = 4;
+/// Fraction of normals on one side of the best-fit plane above which points are an open scan.
+const OPEN_FRACTION: f64 = 0.9;
+/// Closed contour: cells within this many cells of a point are evaluated.
+const BAND_CELLS: i32 = 2;
+
+/// Builds a manifold triangle mesh from `points`, using the scanner `grid` (indices into
+/// `points`) when there is one. See the [module docs](self).
+pub fn reconstruct(
+    points: &[Point3],
+    grid: Option<&RangeGrid>,
+    options: &ReconstructOptions,
+) -> Result<Reconstruction, ReconstructError> {
+    options.validate()?;
+    if let Some(index) = points.iter().position(|p| !p.is_finite()) {
+        return Err(ReconstructError::NonFinitePoint { index });
+    }
+    if points.len() < MIN_POINTS {
+        return Err(ReconstructError::TooFewPoints {
+            count: points.len(),
+            min: MIN_POINTS,
+        });
+    }
+    let tree = Neighbours::new(points);
+    let spacing = tree.mean_distances(points, SPACING_NEIGHBOURS);
+    let inlier = inliers(&spacing, options.outlier_std_ratio);
+    let outliers = inlier.iter().filter(|&&k| !k).count();
+    let kept: Vec<Point3> = points
+        .iter()
+        .zip(&inlier)
+        .filter_map(|(p, &k)| k.then_some(*p))
+        .collect();
+    if kept.len() < MIN_POINTS {
+        return Err(ReconstructError::TooFewPoints {
+            count: kept.len(),
+            min: MIN_POINTS,
+        });
+    }
+    let frame = normals::frame(kept.iter().copied());
+    let extent = frame.values[2].max(0.0).sqrt();
+    if extent == 0.0 {
+        return Err(ReconstructError::Degenerate {
+            what: "all at one place",
+        });
+    }
+    if frame.values[1].max(0.0).sqrt() <= 1e-9 * extent {
+        return Err(ReconstructError::Degenerate { what: "collinear" });
+    }
+    let kind = match (options.kind, grid) {
+        (Some(kind), _) => kind,
+        (None, Some(_)) => SurfaceKind::Open,
+        (None, None) => detect_kind(&kept, &frame, options.neighbours),
+    };
+    let mesh = match kind {
+        SurfaceKind::Open => open_mesh(points, grid, &inlier, &spacing, &frame, options)?,
+        SurfaceKind::Closed => closed_mesh(&kept, &spacing, &inlier, options)?,
+    };
+    Ok(Reconstruction {
+        mesh,
+        kind,
+        outliers,
+    })
+}
+
+/// Which points survive statistical outlier removal (all when `ratio` is `None`).
+fn inliers(spacing: &[f64], ratio: Option<f64>) -> Vec<bool> {
+    let Some(ratio) = ratio else {
+        return vec![true; spacing.len()];
+    };
+    let n = spacing.len() as f64;
+    let mean = spacing.iter().sum::<f64>() / n;
+    let var = spacing.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / n;
+    let limit = mean + ratio * var.sqrt();
+    spacing.iter().map(|&s| s <= limit).collect()
+}
+
+/// Open or closed, from how the oriented normals sit against the best-fit plane.
+fn detect_kind(points: &[Point3], frame: &normals::Frame, k: usize) -> SurfaceKind {
+    let tree = Neighbours::new(points);
+    let axis = frame.axes[0];
+    let mut n = normals::pca_normals(points, &tree, k, axis);
+    normals::orient(points, &mut n, &tree, k);
+    let up = n.iter().filter(|v| v.dot(axis) > 0.0).count() as f64 / n.len() as f64;
+    if up.max(1.0 - up) >= OPEN_FRACTION {
+        SurfaceKind::Open
+    } else {
+        SurfaceKind::Closed
+    }
+}
+
+fn open_mesh(
+    points: &[Point3],
+    grid: Option<&RangeGrid>,
+    inlier: &[bool],
+    spacing: &[f64],
+    frame: &normals::Frame,
+    options: &ReconstructOptions,
+) -> Result<PolyMesh, ReconstructError> {
+    let tris = match grid {
+        Some(g) => open::grid_triangles(g, points.len(), inlier)?,
+        None => open::plane_triangles(points, inlier, frame),
+    };
+    let tris = open::drop_long_edges(tris, points, spacing, options.long_edge_factor);
+    let tris = cleanup::manifold_part(tris, points.len());
+    if tris.is_empty() {
+        return Err(ReconstructError::NoSurface);
+    }
+    PolyMesh::try_new(points.to_vec(), tris).map_err(|_| ReconstructError::NoSurface)
+}
+
+fn closed_mesh(
+    kept: &[Point3],
+    spacing: &[f64],
+    inlier: &[bool],
+    options: &ReconstructOptions,
+) -> Result<PolyMesh, ReconstructError> {
+    let kept_spacing: Vec<f64> = spacing
+        .iter()
+        .zip(inlier)
+        .filter_map(|(s, &k)| k.then_some(*s))
+        .collect();
+    let tree = Neighbours::new(kept);
+    let frame = normals::frame(kept.iter().copied());
+    let mut n = normals::pca_normals(kept, &tree, options.neighbours, frame.axes[0]);
+    normals::orient(kept, &mut n, &tree, options.neighbours);
+    let mut cell = options.cell_size * median(&kept_spacing);
+    if cell <= 0.0 {
+        cell = frame.values[2].sqrt() * 1e-2;
+    }
+    let (positions, tris) = closed::contour(kept, &n, &tree, cell, BAND_CELLS);
+    let tris = cleanup::manifold_part(tris, positions.len());
+    if tris.is_empty() {
+        return Err(ReconstructError::NoSurface);
+    }
+    let (positions, tris) = compact(positions, tris);
+    PolyMesh::try_new(positions, tris).map_err(|_| ReconstructError::NoSurface)
+}
+
+/// Drops vertices in no triangle, renumbering the rest in order.
+fn compact(positions: Vec<Point3>, tris: Vec<[u32; 3]>) -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let mut remap = vec![u32::MAX; positions.len()];
+    let mut out = Vec::new();
+    for t in &tris {
+        for &v in t {
+            if remap[v as usize] == u32::MAX {
+                remap[v as usize] = 0;
+            }
+        }
+    }
+    for (v, p) in positions.into_iter().enumerate() {
+        if remap[v] != u32::MAX {
+            remap[v] = out.len() as u32;
+            out.push(p);
+        }
+    }
+    let tris = tris
+        .into_iter()
+        .map(|t| t.map(|v| remap[v as usize]))
+        .collect();
+    (out, tris)
+}

@@ -1,0 +1,72 @@
+//! Open, single-view scans: triangulate by the scanner grid, or by a 2D Delaunay triangulation
+//! of the points projected onto their best-fit plane, then cut the triangles that span holes
+//! or run outside the scanned outline (edges long against the local point spacing).
+
+use super::normals::Frame;
+use super::ReconstructError;
+use crate::geom::Point3;
+use crate::io::RangeGrid;
+use spade::{DelaunayTriangulation, Point2, Triangulation};
+
+/// Triangles of the range grid, checked against the point count.
+pub(super) fn grid_triangles(
+    grid: &RangeGrid,
+    count: usize,
+    inlier: &[bool],
+) -> Result<Vec<[u32; 3]>, ReconstructError> {
+    let tris = grid.triangles();
+    if let Some(&index) = tris.iter().flatten().find(|&&i| i as usize >= count) {
+        return Err(ReconstructError::GridMismatch { index, count });
+    }
+    Ok(tris
+        .into_iter()
+        .filter(|t| t.iter().all(|&i| inlier[i as usize]))
+        .collect())
+}
+
+/// Delaunay triangles of the inlier points projected onto the plane of `frame` (its two
+/// major axes), wound counter-clockwise seen from the plane's normal (the minor axis).
+pub(super) fn plane_triangles(points: &[Point3], inlier: &[bool], frame: &Frame) -> Vec<[u32; 3]> {
+    let (u, v) = (frame.axes[2], frame.axes[1]);
+    // Orient (u, v, normal) right-handed so faces wind counter-clockwise about the normal.
+    let v = if u.cross(v).dot(frame.axes[0]) < 0.0 {
+        -v
+    } else {
+        v
+    };
+    let mut dt: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::new();
+    let mut original: Vec<u32> = Vec::new();
+    for (i, &p) in points.iter().enumerate() {
+        if !inlier[i] {
+            continue;
+        }
+        let d = p - frame.centroid;
+        if let Ok(h) = dt.insert(Point2::new(d.dot(u), d.dot(v))) {
+            // Duplicates return the vertex already there: the first point keeps it.
+            if h.index() == original.len() {
+                original.push(i as u32);
+            }
+        }
+    }
+    dt.inner_faces()
+        .map(|f| f.vertices().map(|h| original[h.fix().index()]))
+        .collect()
+}
+
+/// `tris` without triangles having an edge longer than `factor` times the local spacing of
+/// its ends (the larger of the two).
+pub(super) fn drop_long_edges(
+    tris: Vec<[u32; 3]>,
+    points: &[Point3],
+    spacing: &[f64],
+    factor: f64,
+) -> Vec<[u32; 3]> {
+    tris.into_iter()
+        .filter(|t| {
+            (0..3).all(|k| {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                points[a].distance(points[b]) <= factor * spacing[a].max(spacing[b])
+            })
+        })
+        .collect()
+}
