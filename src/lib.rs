@@ -9,12 +9,12 @@
 //! | module | what it is |
 //! |---|---|
 //! | [`geom`] | f64 points, vectors, boxes, tolerances |
-//! | [`cloud`] | bare point clouds to meshes (range grid, Delaunay, implicit surface) |
 //! | [`mesh`] | polygon meshes, adjacency, validation, simplification |
 //! | [`subdiv`] | subdivision schemes and exact limit-surface evaluation |
 //! | [`spline`] | B-spline / NURBS curves and surfaces |
 //! | [`fit`] | the fitting engines (geometric iteration, least squares) |
 //! | [`io`] | readers and writers for point and mesh files |
+//! | [`cloud`] | bare point clouds to meshes (range grid, Delaunay, implicit surface) |
 //! | [`export`] | IGES and STEP export of B-spline / NURBS curves and surfaces |
 //!
 //! The core is plain Rust with f64 maths and is tested natively with `cargo test`; the renderer
