@@ -376,15 +376,72 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 if self.options.remesh {
                     self.surface.remesh_control(&mut refined)?;
                 }
+                let old_faces = self.patch_faces_now(&control);
                 self.surface = self.surface.rebuild(&refined)?;
                 self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
                 self.accel.reset();
-                self.search_all_feet()?;
+                self.carry_feet_over(&old_faces, &refined)?;
                 return Ok(true);
             }
             chosen.truncate(chosen.len() / 2);
         }
         Ok(false)
+    }
+
+    /// The corners of the control face of every patch, before a refinement.
+    fn patch_faces_now(&self, control: &PolyMesh) -> Vec<Vec<u32>> {
+        (0..self.surface.num_patches() as u32)
+            .map(|p| {
+                let f = self.surface.patch_face(p);
+                if f < control.num_faces() {
+                    control.face(f).to_vec()
+                } else {
+                    Vec::new()
+                }
+            })
+            .collect()
+    }
+
+    /// Foot points after a refinement: a point whose patch lies on a face the refinement left
+    /// as it was (same corners, same order) starts Newton from its old parameters on that face;
+    /// the others are searched from the spatial index.
+    fn carry_feet_over(&mut self, old: &[Vec<u32>], refined: &PolyMesh) -> Result<(), FitError> {
+        let mut face_patch = std::collections::HashMap::new();
+        for p in (0..self.surface.num_patches() as u32).rev() {
+            let f = self.surface.patch_face(p);
+            if f < refined.num_faces() {
+                face_patch.insert(refined.face(f).to_vec(), p);
+            }
+        }
+        let opts = self.options.newton;
+        for i in 0..self.data.len() {
+            let (p, prev) = (self.data[i], self.feet[i].param);
+            let kept = old
+                .get(prev.patch as usize)
+                .and_then(|corners| face_patch.get(corners));
+            let warm = kept.map(|&patch| {
+                closest_point(
+                    &self.surface,
+                    p,
+                    SurfaceParam { patch, ..prev },
+                    &opts,
+                    self.diagonal,
+                )
+            });
+            self.feet[i] = match warm {
+                Some(foot) if foot.converged => foot,
+                _ => {
+                    let start = self.index.nearest(p).ok_or_else(|| FitError::ControlMesh {
+                        reason: format!(
+                            "the limit surface has no finite point near data point {i}"
+                        ),
+                    })?;
+                    closest_point(&self.surface, p, start, &opts, self.diagonal)
+                }
+            };
+        }
+        self.update_errors();
+        Ok(())
     }
 
     fn due_for_refinement(&self, improvement: f64) -> bool {

@@ -83,6 +83,9 @@ pub struct Args {
     /// Never split control faces.
     #[arg(long)]
     no_refine: bool,
+    /// No edge flips after a refinement (Loop).
+    #[arg(long)]
+    no_remesh: bool,
     /// Error-vector weighting.
     #[arg(long, value_enum, default_value = "basis")]
     weights: WeightsArg,
@@ -129,6 +132,7 @@ impl Args {
             .with_max_iter(self.max_iter)
             .with_max_control(self.max_control)
             .with_refine(!self.no_refine)
+            .with_remesh(!self.no_remesh)
             .with_weighting(match self.weights {
                 WeightsArg::Patent => Weighting::Patent,
                 WeightsArg::Basis => Weighting::Basis,

@@ -4,8 +4,8 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod export_samples;
-mod fit_curve;
 mod fit;
+mod fit_curve;
 mod info;
 mod simplify;
 mod subdiv;
