@@ -1,6 +1,7 @@
 //! Limit-surface evaluation rate: one million (patch, u, v) samples with first and second
 //! derivatives on a QEM-decimated Stanford bunny (718 control points, 1,219 triangles, open,
-//! most vertices extraordinary), for Loop and for Catmull–Clark on its quadrangulation.
+//! most vertices extraordinary), for Loop, Catmull–Clark (on its quadrangulation) and
+//! Doo–Sabin (one patch per face corner at an interior vertex).
 //!
 //! Run: `cargo bench --bench limit_eval`. Prints samples per second for each scheme. A plain
 //! timing loop (no criterion) keeps the dev-dependencies and the build small.
@@ -52,7 +53,7 @@ fn main() {
             return;
         }
     };
-    for scheme in [Scheme::Loop, Scheme::CatmullClark] {
+    for scheme in [Scheme::Loop, Scheme::CatmullClark, Scheme::DooSabin] {
         let start = Instant::now();
         let surface = match build(scheme, &mesh) {
             Ok(s) => s,

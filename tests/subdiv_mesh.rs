@@ -137,10 +137,16 @@ fn build_gives_working_surfaces_for_both_schemes() {
         v: 0.5,
     });
     assert!(e.point.is_finite() && e.du.cross(e.dv).length() > 0.0);
-    assert!(matches!(
-        build(Scheme::DooSabin, &icosahedron()),
-        Err(SubdivError::Unsupported { .. })
-    ));
+    let s = build(Scheme::DooSabin, &icosahedron()).unwrap();
+    assert_eq!(s.num_patches(), 60);
+    assert!(s
+        .eval(SurfaceParam {
+            patch: 7,
+            u: 0.3,
+            v: 0.6
+        })
+        .point
+        .is_finite());
 }
 
 #[test]

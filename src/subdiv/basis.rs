@@ -144,6 +144,37 @@ pub(crate) fn bicubic(u: f64, v: f64) -> Weights<16> {
     w
 }
 
+/// Uniform quadratic B-spline basis on [0, 1] (value, first, second derivative).
+fn quadratic(t: f64) -> [[f64; 3]; 3] {
+    let s = 1.0 - t;
+    [
+        [
+            s * s / 2.0,
+            (-2.0 * t * t + 2.0 * t + 1.0) / 2.0,
+            t * t / 2.0,
+        ],
+        [-s, 1.0 - 2.0 * t, t],
+        [1.0, -2.0, 1.0],
+    ]
+}
+
+/// Biquadratic B-spline weights of the 3 × 3 points (i, j) ∈ {-1, 0, 1}², index
+/// `3 (j + 1) + (i + 1)`, at (u, v): the regular Doo–Sabin patch of the middle point, whose
+/// corners are the centroids of its four faces.
+pub(crate) fn biquadratic(u: f64, v: f64) -> Weights<9> {
+    let (bu, bv) = (quadratic(u), quadratic(v));
+    const ORDERS: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
+    let mut w = [[0.0; 9]; 6];
+    for (d, &(ou, ov)) in ORDERS.iter().enumerate() {
+        for j in 0..3 {
+            for i in 0..3 {
+                w[d][3 * j + i] = bu[ou][i] * bv[ov][j];
+            }
+        }
+    }
+    w
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,7 +1,7 @@
 //! Doo–Sabin refinement: a dual scheme. Every face corner gives a new point; the new mesh has a
 //! face for each old face, each interior edge (a quad) and each interior vertex.
 
-use super::topo::{EdgeTag, Refined, Stencil, Topo, NO};
+use super::topo::{key, EdgeTag, Refined, Stencil, Topo, NO};
 use std::f64::consts::PI;
 
 /// Doo–Sabin weight of corner `k` (counted from the corner whose point is made) in an n-gon:
@@ -32,10 +32,27 @@ pub(crate) fn refine(t: &Topo) -> Refined {
     };
     let mut starts = vec![0u32];
     let mut verts: Vec<u32> = Vec::new();
+    // New edges on the mesh boundary: along old open edges, and across the missing vertex faces
+    // of boundary vertices. Edges cut by a neighbourhood's rim stay untagged (rim).
+    let mut open: std::collections::HashSet<(u32, u32)> = std::collections::HashSet::new();
+    let on_boundary = |v: u32| {
+        t.vertex_edges(v)
+            .iter()
+            .any(|&e| t.edge_tags[e as usize].open)
+    };
     for f in 0..t.num_faces() as u32 {
         let s = t.face_starts[f as usize];
-        verts.extend((0..t.face(f).len() as u32).map(|i| s + i));
+        let n = t.face(f).len() as u32;
+        verts.extend((0..n).map(|i| s + i));
         starts.push(verts.len() as u32);
+        for (j, &e) in t.face_edges[s as usize..(s + n) as usize]
+            .iter()
+            .enumerate()
+        {
+            if t.edge_tags[e as usize].open {
+                open.insert(key(s + j as u32, s + (j as u32 + 1) % n));
+            }
+        }
     }
     for (e, &[a, b]) in t.edges.iter().enumerate() {
         let [f0, f1] = t.edge_faces[e];
@@ -55,6 +72,11 @@ pub(crate) fn refine(t: &Topo) -> Refined {
         };
         verts.extend([corner(g, a), corner(g, b), corner(f, b), corner(f, a)]);
         starts.push(verts.len() as u32);
+        for v in [a, b] {
+            if on_boundary(v) {
+                open.insert(key(corner(g, v), corner(f, v)));
+            }
+        }
     }
     let mut fan = Vec::new();
     for v in 0..t.nv as u32 {
@@ -69,8 +91,16 @@ pub(crate) fn refine(t: &Topo) -> Refined {
         starts.push(verts.len() as u32);
     }
     let count = points.len();
-    let topo = Topo::new(count, starts, verts, |_, _| EdgeTag::default());
-    let topo = retag_open(topo);
+    let topo = Topo::new(count, starts, verts, |a, b| {
+        if open.contains(&(a, b)) {
+            EdgeTag {
+                sharp: true,
+                open: true,
+            }
+        } else {
+            EdgeTag::default()
+        }
+    });
     Refined { points, topo }
 }
 
@@ -92,15 +122,29 @@ fn corner_point(t: &Topo, f: u32, j: usize, c: &[u32]) -> Stencil {
     }
 }
 
-/// Marks one-face edges of a refined whole mesh as open boundary.
-fn retag_open(mut topo: Topo) -> Topo {
-    for e in 0..topo.edges.len() {
-        if topo.edge_faces[e][1] == NO {
-            topo.edge_tags[e] = EdgeTag {
-                sharp: true,
-                open: true,
-            };
-        }
+/// The limit point of an interior vertex: the centroid of the new points of its corners, which
+/// every later Doo–Sabin step keeps (the vertex's face shrinks onto it). A vertex on an open
+/// boundary gives itself.
+pub(crate) fn vertex_limit(t: &Topo, v: u32) -> Option<Stencil> {
+    let edges = t.vertex_edges(v);
+    if edges.is_empty()
+        || !t.is_complete(v)
+        || edges.iter().any(|&e| t.edge_faces[e as usize][1] == NO)
+    {
+        return Some(vec![(v, 1.0)]);
     }
-    topo
+    let mut faces = Vec::new();
+    t.fan(v, t.edge_faces[edges[0] as usize][0], false, &mut faces);
+    let share = 1.0 / faces.len() as f64;
+    let mut s = Vec::new();
+    for &f in &faces {
+        let c = t.face(f);
+        let j = t.corner_index(f, v)?;
+        s.extend(
+            corner_point(t, f, j, c)
+                .into_iter()
+                .map(|(i, w)| (i, w * share)),
+        );
+    }
+    Some(super::topo::merge(s))
 }

@@ -144,7 +144,8 @@ pub trait LimitSurface {
     fn relocate(&self, patch: u32, u: f64, v: f64) -> SurfaceParam;
 }
 
-/// The limit surface of `mesh` under `scheme`, ready for fitting. Loop needs a triangle mesh;
+/// The limit surface of `mesh` under `scheme`, ready for fitting. Loop needs a triangle mesh,
+/// Doo–Sabin takes any polygons;
 /// for Catmull–Clark a mesh that is not all quads is first converted by one Catmull–Clark step
 /// ([`quadrangulate`]), so its control points are then those of the converted mesh (read them
 /// with [`LimitSurface::control_points`]).
@@ -216,6 +217,13 @@ scheme_surface!(
     /// exact local subdivision near extraordinary vertices, boundaries and creases.
     LoopSurface,
     Scheme::Loop
+);
+scheme_surface!(
+    /// Doo–Sabin limit surface of a polygon control mesh: one patch per face corner at an
+    /// interior vertex, biquadratic B-spline where the refined vertex has four quads around it,
+    /// exact local subdivision around non-quad faces (whose centroids the surface interpolates).
+    DooSabinSurface,
+    Scheme::DooSabin
 );
 scheme_surface!(
     /// Catmull–Clark limit surface of a quad control mesh: bicubic B-spline patches (with

@@ -12,7 +12,7 @@
 //! share one node, and the sub-patch at an extraordinary vertex maps to itself after the first
 //! step (a self-loop in the graph), as in Stam's eigen-analysis but without eigenvectors.
 
-use super::basis::{bicubic, bicubic_lattice, loop_box, LOOP_LATTICE};
+use super::basis::{bicubic, bicubic_lattice, biquadratic, loop_box, LOOP_LATTICE};
 use super::topo::{key, EdgeTag, Stencil, Topo, NO};
 use super::{LimitEval, Scheme, SubdivError};
 use crate::geom::{Point3, Vec3};
@@ -140,7 +140,7 @@ pub(crate) struct Graph {
     scheme: Scheme,
     nodes: Vec<Node>,
     index: HashMap<Vec<u32>, u32>,
-    pending: Vec<(u32, Topo)>,
+    pending: Vec<(u32, Topo, Kind)>,
 }
 
 /// A canonical neighbourhood of one face: local topology and where each local point came from.
@@ -148,6 +148,7 @@ pub(crate) struct Neighbourhood {
     pub topo: Topo,
     pub source: Vec<u32>,
     key: Vec<u32>,
+    kind: Kind,
 }
 
 /// Gathers the faces around every corner of `f` in a canonical order: corners first, then the
@@ -180,14 +181,56 @@ pub(crate) fn neighbourhood(src: &Topo, f: u32) -> Neighbourhood {
             }
         }
     }
+    finish(src, source, &local, &faces, Kind::Face)
+}
+
+/// What a neighbourhood is the neighbourhood of: a face (Loop, Catmull–Clark patches), a
+/// vertex (Doo–Sabin patches: the vertex's faces), or a control vertex whose fan is refined
+/// once to reach the Doo–Sabin patch of one face corner (the root of a Doo–Sabin patch).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kind {
+    Face,
+    Vertex,
+    DooSabinRoot,
+}
+
+/// Gathers the faces around vertex `v` counter-clockwise from `f` (local vertex 0 is `v`).
+pub(crate) fn vertex_neighbourhood(src: &Topo, v: u32, f: u32, kind: Kind) -> Neighbourhood {
+    let mut source = vec![v];
+    let mut local: HashMap<u32, u32> = HashMap::from([(v, 0)]);
+    let mut faces = Vec::new();
+    src.fan(v, f, false, &mut faces);
+    for &g in &faces {
+        let gv = src.face(g);
+        let start = gv.iter().position(|&x| x == v).unwrap_or(0);
+        for i in 0..gv.len() {
+            let w = gv[(start + i) % gv.len()];
+            local.entry(w).or_insert_with(|| {
+                source.push(w);
+                (source.len() - 1) as u32
+            });
+        }
+    }
+    finish(src, source, &local, &faces, kind)
+}
+
+/// Builds the local topology of `faces` (face 0 rotated to start at local vertex 0, the others
+/// at their smallest local index) and the key that identifies its shape.
+fn finish(
+    src: &Topo,
+    source: Vec<u32>,
+    local: &HashMap<u32, u32>,
+    faces: &[u32],
+    kind: Kind,
+) -> Neighbourhood {
     let mut starts = vec![0u32];
     let mut verts = Vec::new();
     let mut tags: HashMap<(u32, u32), EdgeTag> = HashMap::new();
-    let mut key_out = vec![source.len() as u32, faces.len() as u32];
+    let mut key_out = vec![kind as u32, source.len() as u32, faces.len() as u32];
     for (n, &g) in faces.iter().enumerate() {
         let gv: Vec<u32> = src.face(g).iter().map(|v| local[v]).collect();
         let rot = if n == 0 {
-            0
+            gv.iter().position(|&x| x == 0).unwrap_or(0)
         } else {
             (0..gv.len()).min_by_key(|&i| gv[i]).unwrap_or(0)
         };
@@ -214,6 +257,7 @@ pub(crate) fn neighbourhood(src: &Topo, f: u32) -> Neighbourhood {
         topo,
         source,
         key: key_out,
+        kind,
     }
 }
 
@@ -279,7 +323,9 @@ fn domain_centre(scheme: Scheme) -> (f64, f64) {
 fn unfold(topo: &Topo, scheme: Scheme) -> Option<Vec<Option<(i32, i32)>>> {
     let n = if scheme == Scheme::Loop { 3 } else { 4 };
     let mut coords: Vec<Option<(i32, i32)>> = vec![None; topo.nv];
-    let start: &[(i32, i32)] = if n == 3 {
+    let start: &[(i32, i32)] = if scheme == Scheme::DooSabin {
+        &[(0, 0), (-1, 0), (-1, -1), (0, -1)]
+    } else if n == 3 {
         &[(0, 0), (1, 0), (0, 1)]
     } else {
         &[(0, 0), (1, 0), (1, 1), (0, 1)]
@@ -367,6 +413,9 @@ fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
 /// The `nb × k` matrix that makes a regular patch's spline control points, or `None` if the
 /// neighbourhood is not regular.
 fn regular_gather(topo: &Topo, scheme: Scheme) -> Option<Vec<f64>> {
+    if scheme == Scheme::DooSabin {
+        return doo_sabin_gather(topo);
+    }
     let corners = topo.face(0).to_vec();
     if !corners.iter().all(|&c| corner_is_regular(topo, scheme, c)) {
         return None;
@@ -438,6 +487,32 @@ fn regular_gather(topo: &Topo, scheme: Scheme) -> Option<Vec<f64>> {
     }
 }
 
+/// A Doo–Sabin vertex patch is regular when the vertex has four quads around it: the patch is
+/// then the biquadratic B-spline over their nine points.
+fn doo_sabin_gather(topo: &Topo) -> Option<Vec<f64>> {
+    if !topo.is_complete(0) || topo.vertex_edges(0).len() != 4 || topo.num_faces() != 4 {
+        return None;
+    }
+    if (0..4).any(|g| topo.face(g).len() != 4) {
+        return None;
+    }
+    let coords = unfold(topo, Scheme::DooSabin)?;
+    let k = topo.nv;
+    let mut g = vec![0.0; 9 * k];
+    for (v, c) in coords.iter().enumerate() {
+        let (i, j) = (*c)?;
+        if !(-1..=1).contains(&i) || !(-1..=1).contains(&j) {
+            return None;
+        }
+        let r = (3 * (j + 1) + (i + 1)) as usize;
+        if g[r * k..(r + 1) * k].iter().any(|&w| w != 0.0) {
+            return None;
+        }
+        g[r * k + v] = 1.0;
+    }
+    Some(g)
+}
+
 impl Graph {
     pub fn new(scheme: Scheme) -> Graph {
         Graph {
@@ -450,15 +525,22 @@ impl Graph {
 
     /// The node of a neighbourhood, building it and everything below it if new.
     pub fn add(&mut self, nb: Neighbourhood, patch: usize) -> Result<u32, SubdivError> {
-        let id = self.intern(nb.key, nb.topo, patch)?;
-        while let Some((node, topo)) = self.pending.pop() {
-            let built = self.build(&topo, patch)?;
+        let id = self.intern(nb, patch)?;
+        while let Some((node, topo, kind)) = self.pending.pop() {
+            let built = if kind == Kind::DooSabinRoot {
+                self.build_doo_sabin_root(&topo, patch)?
+            } else {
+                self.build(&topo, kind, patch)?
+            };
             self.nodes[node as usize] = built;
         }
         Ok(id)
     }
 
-    fn intern(&mut self, key: Vec<u32>, topo: Topo, patch: usize) -> Result<u32, SubdivError> {
+    fn intern(&mut self, nb: Neighbourhood, patch: usize) -> Result<u32, SubdivError> {
+        let Neighbourhood {
+            topo, key, kind, ..
+        } = nb;
         if let Some(&id) = self.index.get(&key) {
             return Ok(id);
         }
@@ -472,11 +554,55 @@ impl Graph {
         let id = self.nodes.len() as u32;
         self.nodes.push(Node::Pending);
         self.index.insert(key, id);
-        self.pending.push((id, topo));
+        self.pending.push((id, topo, kind));
         Ok(id)
     }
 
-    fn build(&mut self, topo: &Topo, patch: usize) -> Result<Node, SubdivError> {
+    /// The child matrix and node of the neighbourhood `nb` of refined points.
+    fn child(
+        &mut self,
+        refined: &super::topo::Refined,
+        nb: Neighbourhood,
+        k: usize,
+        map: ChildMap,
+        patch: usize,
+    ) -> Result<Child, SubdivError> {
+        let kc = nb.topo.nv;
+        let mut mat = vec![0.0; kc * k];
+        for (row, &p) in nb.source.iter().enumerate() {
+            let stencil = refined.points[p as usize]
+                .as_ref()
+                .ok_or(SubdivError::Unevaluable { patch })?;
+            for &(j, w) in stencil {
+                mat[row * k + j as usize] += w;
+            }
+        }
+        let node = self.intern(nb, patch)?;
+        Ok(Child {
+            node,
+            k: kc,
+            mat: Sparse::from_dense(kc, k, &mat),
+            map,
+        })
+    }
+
+    /// The root of a Doo–Sabin patch: the fan of a control vertex, refined once; the patch is
+    /// the new point of face 0's corner at the vertex, with the same parameters.
+    fn build_doo_sabin_root(&mut self, topo: &Topo, patch: usize) -> Result<Node, SubdivError> {
+        let refined = topo.refine(Scheme::DooSabin);
+        // Face 0 starts at local vertex 0, so its corner point is new point 0, and the face
+        // made from face 0 is new face 0.
+        let nb = vertex_neighbourhood(&refined.topo, 0, 0, Kind::Vertex);
+        let identity = ChildMap::new([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]);
+        let child = self.child(&refined, nb, topo.nv, identity, patch)?;
+        Ok(Node::Split {
+            k: topo.nv,
+            children: vec![child],
+            corner_masks: Vec::new(),
+        })
+    }
+
+    fn build(&mut self, topo: &Topo, kind: Kind, patch: usize) -> Result<Node, SubdivError> {
         let k = topo.nv;
         if let Some(gather) = regular_gather(topo, self.scheme) {
             let rows = gather.len() / k.max(1);
@@ -489,23 +615,31 @@ impl Graph {
         let maps = child_maps(self.scheme);
         let mut children = Vec::with_capacity(maps.len());
         for (ci, map) in maps.into_iter().enumerate() {
-            let nb = neighbourhood(&refined.topo, ci as u32);
-            let kc = nb.topo.nv;
-            let mut mat = vec![0.0; kc * k];
-            for (row, &p) in nb.source.iter().enumerate() {
-                let stencil = refined.points[p as usize]
-                    .as_ref()
-                    .ok_or(SubdivError::Unevaluable { patch })?;
-                for &(j, w) in stencil {
-                    mat[row * k + j as usize] += w;
-                }
-            }
-            let node = self.intern(nb.key, nb.topo, patch)?;
-            children.push(Child {
-                node,
-                k: kc,
-                mat: Sparse::from_dense(kc, k, &mat),
-                map,
+            let nb = if kind == Kind::Vertex {
+                // Child ci is the new point of face ci's corner at vertex 0; its faces start
+                // with the face made from face ci.
+                let p = p_of(topo, ci, topo.face_starts[ci]);
+                vertex_neighbourhood(&refined.topo, p, ci as u32, Kind::Vertex)
+            } else {
+                neighbourhood(&refined.topo, ci as u32)
+            };
+            children.push(self.child(&refined, nb, k, map, patch)?);
+        }
+        if kind == Kind::Vertex {
+            // The limit at a patch corner is the centroid of the face there (Doo–Sabin keeps
+            // face centroids).
+            let corner_masks = (0..4u32)
+                .map(|q| {
+                    let f = topo.face(q);
+                    f.iter()
+                        .map(|&i| (i as u16, 1.0 / f.len() as f64))
+                        .collect()
+                })
+                .collect();
+            return Ok(Node::Split {
+                k,
+                children,
+                corner_masks,
             });
         }
         let corner_masks = topo
@@ -565,7 +699,11 @@ impl Graph {
                         path.leaf = node;
                         return path;
                     }
-                    let ci = pick_child(self.scheme, path.u, path.v);
+                    let ci = if children.len() == 1 {
+                        0
+                    } else {
+                        pick_child(self.scheme, path.u, path.v)
+                    };
                     let ch = &children[ci];
                     (path.u, path.v) = ch.map.apply(path.u, path.v);
                     path.g = mul2(ch.map.m, path.g);
@@ -644,7 +782,8 @@ impl Graph {
         gather.apply(pts, &mut cp);
         match self.scheme {
             Scheme::Loop => combine(&loop_box(u, v), &cp[..12]),
-            _ => combine(&bicubic(u, v), &cp[..16]),
+            Scheme::CatmullClark => combine(&bicubic(u, v), &cp[..16]),
+            Scheme::DooSabin => combine(&biquadratic(u, v), &cp[..9]),
         }
     }
 
@@ -665,7 +804,8 @@ impl Graph {
             Node::Regular { k, gather } => {
                 let basis: Vec<f64> = match self.scheme {
                     Scheme::Loop => loop_box(path.u, path.v)[0].to_vec(),
-                    _ => bicubic(path.u, path.v)[0].to_vec(),
+                    Scheme::CatmullClark => bicubic(path.u, path.v)[0].to_vec(),
+                    Scheme::DooSabin => biquadratic(path.u, path.v)[0].to_vec(),
                 };
                 let mut w = vec![0.0; *k];
                 gather.pull_back(&basis, &mut w);
@@ -764,4 +904,10 @@ pub(crate) fn chain(e: &mut LimitEval, g: [[f64; 2]; 2]) {
     e.duu = second(0, 0);
     e.duv = second(0, 1);
     e.dvv = second(1, 1);
+}
+
+/// The new point of local face `q`'s corner at vertex 0: Doo–Sabin numbers new points by face
+/// corner, and local faces of a vertex neighbourhood start at vertex 0 (face 0) or not.
+fn p_of(topo: &Topo, q: usize, first: u32) -> u32 {
+    first + topo.corner_index(q as u32, 0).unwrap_or(0) as u32
 }

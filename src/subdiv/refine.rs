@@ -49,20 +49,18 @@ pub fn refine_levels(
 }
 
 /// Exact limit positions of the vertices of `mesh` under `scheme` (limit masks), without
-/// building an evaluator. Doo–Sabin is not supported (its limit points are not at vertices).
+/// building an evaluator. For Doo–Sabin the limit point of an interior vertex is the centroid
+/// of its vertex face (kept by every step); boundary vertices give themselves.
 pub fn limit_positions(scheme: Scheme, mesh: &ControlMesh) -> Result<Vec<Point3>, SubdivError> {
-    if scheme == Scheme::DooSabin {
-        return Err(SubdivError::Unsupported {
-            what: "Doo–Sabin limit positions",
-        });
-    }
     let topo = topo_of(mesh);
     let p = mesh.positions();
     (0..mesh.num_vertices() as u32)
         .map(|v| {
-            let s = topo
-                .limit_stencil(scheme, v)
-                .ok_or(SubdivError::Unevaluable { patch: 0 })?;
+            let s = match scheme {
+                Scheme::DooSabin => super::doo_sabin::vertex_limit(&topo, v),
+                _ => topo.limit_stencil(scheme, v),
+            }
+            .ok_or(SubdivError::Unevaluable { patch: 0 })?;
             Ok(s.iter().map(|&(i, w)| p[i as usize] * w).sum())
         })
         .collect()

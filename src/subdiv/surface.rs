@@ -1,7 +1,7 @@
 //! [`SubdivSurface`]: the limit surface of a control mesh under one scheme, with everything
 //! topological precomputed so evaluation after moving control points is only weighted sums.
 
-use super::patch::{combine, neighbourhood, Graph};
+use super::patch::{combine, neighbourhood, vertex_neighbourhood, Graph, Kind};
 use super::topo::{EdgeTag, Topo};
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
 use crate::geom::{Point3, Vec3};
@@ -23,10 +23,32 @@ pub struct SubdivSurface {
     mesh: ControlMesh,
     graph: Graph,
     patches: Vec<Patch>,
+    /// Face and vertex of each patch: the face itself for Loop and Catmull–Clark; for
+    /// Doo–Sabin the face corner at an interior vertex whose refined point the patch belongs to.
+    sites: Vec<(u32, u32)>,
     ctrl: Vec<u32>,
     /// Limit stencil of every control vertex (limit masks), flattened.
     limit_starts: Vec<u32>,
     limit_weights: Vec<(u32, f64)>,
+}
+
+/// The (face, vertex) of every patch: one per face for the primal schemes; one per corner at
+/// an interior vertex for Doo–Sabin (its limit near open boundaries is not covered).
+fn patch_sites(scheme: Scheme, mesh: &ControlMesh, topo: &Topo) -> Vec<(u32, u32)> {
+    let mut sites = Vec::new();
+    for f in 0..mesh.num_faces() as u32 {
+        match scheme {
+            Scheme::DooSabin => {
+                for v in mesh.face_vertices(f) {
+                    if topo.is_complete(v) && !mesh.is_boundary_vertex(v) {
+                        sites.push((f, v));
+                    }
+                }
+            }
+            _ => sites.push((f, mesh.face_vertices(f).next().unwrap_or(0))),
+        }
+    }
+    sites
 }
 
 /// Builds the edge-tagged topology of a control mesh.
@@ -57,18 +79,14 @@ impl SubdivSurface {
         let needed = match scheme {
             Scheme::Loop => 3,
             Scheme::CatmullClark => 4,
-            Scheme::DooSabin => {
-                return Err(SubdivError::Unsupported {
-                    what: "Doo–Sabin limit evaluation",
-                })
-            }
+            Scheme::DooSabin => 0,
         };
         if mesh.num_faces() == 0 {
             return Err(SubdivError::NoFaces);
         }
         for f in 0..mesh.num_faces() as u32 {
             let len = mesh.face_len(f);
-            if len != needed {
+            if needed != 0 && len != needed {
                 return Err(SubdivError::WrongFaceSize {
                     face: f as usize,
                     len,
@@ -80,10 +98,14 @@ impl SubdivSurface {
         let mut graph = Graph::new(scheme);
         let mut patches = Vec::with_capacity(mesh.num_faces());
         let mut ctrl = Vec::new();
-        for f in 0..mesh.num_faces() {
-            let nb = neighbourhood(&topo, f as u32);
+        let sites = patch_sites(scheme, &mesh, &topo);
+        for (patch, &(f, v)) in sites.iter().enumerate() {
+            let nb = match scheme {
+                Scheme::DooSabin => vertex_neighbourhood(&topo, v, f, Kind::DooSabinRoot),
+                _ => neighbourhood(&topo, f),
+            };
             let source = nb.source.clone();
-            let node = graph.add(nb, f)?;
+            let node = graph.add(nb, patch)?;
             let start = ctrl.len() as u32;
             match graph.direct_picks(node) {
                 Some(picks) => {
@@ -109,9 +131,11 @@ impl SubdivSurface {
         let mut limit_starts = vec![0u32];
         let mut limit_weights = Vec::new();
         for v in 0..mesh.num_vertices() as u32 {
-            let s = topo
-                .limit_stencil(scheme, v)
-                .ok_or(SubdivError::Unevaluable { patch: 0 })?;
+            let s = match scheme {
+                Scheme::DooSabin => super::doo_sabin::vertex_limit(&topo, v),
+                _ => topo.limit_stencil(scheme, v),
+            }
+            .ok_or(SubdivError::Unevaluable { patch: 0 })?;
             limit_weights.extend(s);
             limit_starts.push(limit_weights.len() as u32);
         }
@@ -120,10 +144,18 @@ impl SubdivSurface {
             mesh,
             graph,
             patches,
+            sites,
             ctrl,
             limit_starts,
             limit_weights,
         })
+    }
+
+    /// The control face and vertex of `patch`: for Loop and Catmull–Clark the face (and its
+    /// first corner); for Doo–Sabin the face corner at the vertex whose region the patch covers
+    /// (parameter (0, 0) is at the face's centroid, (1, 1) at the vertex's limit point).
+    pub fn patch_site(&self, patch: u32) -> Option<(u32, u32)> {
+        self.sites.get(patch as usize).copied()
     }
 
     /// The scheme.
@@ -151,6 +183,18 @@ impl SubdivSurface {
     /// Unit limit normals of the control vertices (zero for vertices in no face), from the
     /// limit tangent plane of a patch at that corner.
     pub fn limit_normals(&self) -> Vec<Vec3> {
+        if self.scheme == Scheme::DooSabin {
+            let mut normals = vec![Vec3::ZERO; self.mesh.num_vertices()];
+            for (patch, &(_, v)) in self.sites.iter().enumerate() {
+                let e = self.eval(SurfaceParam {
+                    patch: patch as u32,
+                    u: 1.0,
+                    v: 1.0,
+                });
+                normals[v as usize] = e.du.cross(e.dv).normalize_or_zero();
+            }
+            return normals;
+        }
         (0..self.mesh.num_vertices() as u32)
             .map(|v| {
                 let h = self.mesh.vertex_half_edge(v);
@@ -323,9 +367,19 @@ impl LimitSurface for SubdivSurface {
         let Some((_, u, v)) = self.patch(at) else {
             return;
         };
-        let corners: Vec<u32> = self.mesh.face_vertices(at.patch).collect();
+        let (face, vertex) = self.sites[at.patch as usize];
+        let corners: Vec<u32> = self.mesh.face_vertices(face).collect();
         let (u, v) = (u.clamp(0.0, 1.0), v.clamp(0.0, 1.0));
         match self.scheme {
+            Scheme::DooSabin => {
+                // The patch spans from the face centroid (u = v = 0) to the vertex (u = v = 1):
+                // the vertex's share grows bilinearly, the rest is spread over the face.
+                let own = u * v + 0.5 * (u * (1.0 - v) + (1.0 - u) * v);
+                let spread = (1.0 - own) / corners.len() as f64;
+                for &c in &corners {
+                    out.push((c, spread + if c == vertex { own } else { 0.0 }));
+                }
+            }
             Scheme::Loop => {
                 let s = u + v;
                 let (u, v) = if s > 1.0 { (u / s, v / s) } else { (u, v) };
@@ -341,6 +395,26 @@ impl LimitSurface for SubdivSurface {
     }
 
     fn relocate(&self, patch: u32, u: f64, v: f64) -> SurfaceParam {
+        if self.scheme == Scheme::DooSabin {
+            // Doo–Sabin patches are clamped onto their own domain (no walking yet).
+            let clean = |x: f64| {
+                if x.is_finite() {
+                    x.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            };
+            let patch = if (patch as usize) < self.patches.len() {
+                patch
+            } else {
+                0
+            };
+            return SurfaceParam {
+                patch,
+                u: clean(u),
+                v: clean(v),
+            };
+        }
         super::walk::relocate(&self.mesh, self.scheme, patch, u, v)
     }
 }

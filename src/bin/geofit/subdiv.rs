@@ -26,7 +26,8 @@ pub struct Args {
     /// Output OBJ file.
     #[arg(short, long)]
     output: PathBuf,
-    /// Move the output vertices to their exact limit positions (Loop, Catmull–Clark).
+    /// Move the output vertices to their exact limit positions (for Doo–Sabin: the limit
+    /// points of interior vertices).
     #[arg(long)]
     limit: bool,
 }
