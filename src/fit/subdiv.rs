@@ -366,6 +366,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
     fn refine(&mut self) -> Result<bool, FitError> {
         let mut chosen = self.faces_to_split();
         let control = self.control_mesh();
+        let mut last_size = None;
         while !chosen.is_empty() {
             let mut marked = vec![false; control.num_faces()];
             for &f in &chosen {
@@ -383,6 +384,10 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 self.carry_feet_over(&old_faces, &refined)?;
                 return Ok(true);
             }
+            if last_size == Some(refined.num_vertices()) {
+                break; // the scheme refines globally: fewer marks do not make it smaller
+            }
+            last_size = Some(refined.num_vertices());
             chosen.truncate(chosen.len() / 2);
         }
         Ok(false)
