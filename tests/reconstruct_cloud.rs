@@ -115,3 +115,53 @@ fn coplanar_and_duplicated_points_make_an_open_sheet() {
     assert_manifold(&r.mesh);
     assert_eq!(euler_characteristic(&r.mesh), 1);
 }
+
+#[test]
+fn outlier_removal_drops_stray_points() {
+    let mut points: Vec<Point3> = (0..25 * 25)
+        .map(|k| {
+            let (x, y) = ((k % 25) as f64, (k / 25) as f64);
+            Point3::new(
+                x,
+                y,
+                0.05 * ((x - 12.0).powi(2) + (y - 12.0).powi(2)) / 12.0,
+            )
+        })
+        .collect();
+    points.extend([Point3::new(5.0, 5.0, 40.0), Point3::new(-30.0, 8.0, 3.0)]);
+    let options = ReconstructOptions::default().with_outlier_std_ratio(Some(3.0));
+    let r = reconstruct(&points, None, &options).unwrap();
+    assert_eq!(r.outliers, 2);
+    assert_eq!(r.kind, SurfaceKind::Open);
+    let used: std::collections::BTreeSet<u32> = r.mesh.triangles().into_iter().flatten().collect();
+    assert!(!used.contains(&625) && !used.contains(&626));
+    assert_manifold(&r.mesh);
+}
+
+mod never_panics {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Random small clouds (duplicates, flat and collinear ones included) give a mesh or a
+        /// typed error, never a panic, for either kind.
+        #[test]
+        fn on_random_clouds(
+            coords in prop::collection::vec((-4i32..4, -4i32..4, -1i32..2), 0..60),
+            closed in any::<bool>(),
+        ) {
+            let points: Vec<Point3> = coords
+                .iter()
+                .map(|&(x, y, z)| Point3::new(x as f64, y as f64, z as f64 * 0.5))
+                .collect();
+            let kind = if closed { SurfaceKind::Closed } else { SurfaceKind::Open };
+            let options = ReconstructOptions::default().with_kind(Some(kind));
+            if let Ok(r) = reconstruct(&points, None, &options) {
+                assert_manifold(&r.mesh);
+                prop_assert!(r.mesh.positions().iter().all(|p| p.is_finite()));
+            }
+        }
+    }
+}

@@ -75,19 +75,17 @@ pub(super) fn contour(
         .fold(Point3::splat(f64::INFINITY), |m, &p| m.min(p))
         - Vec3::splat(cell * (band + 1) as f64);
     let key_of = |p: Point3| ((p - origin) / cell).floor().as_ivec3().to_array();
-    let mut cells: Vec<Key> = Vec::new();
-    for &p in points {
-        let k = key_of(p);
+    let mut seeds: Vec<Key> = points.iter().map(|&p| key_of(p)).collect();
+    seeds.sort_unstable();
+    seeds.dedup();
+    let mut cells: Vec<Key> = Vec::with_capacity(seeds.len() * 27);
+    for k in &seeds {
         for dx in -band..=band {
             for dy in -band..=band {
                 for dz in -band..=band {
                     cells.push([k[0] + dx, k[1] + dy, k[2] + dz]);
                 }
             }
-        }
-        if cells.len() > 1 << 22 {
-            cells.sort_unstable();
-            cells.dedup();
         }
     }
     cells.sort_unstable();

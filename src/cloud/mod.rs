@@ -45,7 +45,7 @@ mod open;
 
 pub use error::ReconstructError;
 
-use crate::geom::Point3;
+use crate::geom::{Point3, Vec3};
 use crate::io::RangeGrid;
 use crate::mesh::PolyMesh;
 use neighbours::{median, Neighbours};
@@ -210,14 +210,19 @@ pub fn reconstruct(
     if frame.values[1].max(0.0).sqrt() <= 1e-9 * extent {
         return Err(ReconstructError::Degenerate { what: "collinear" });
     }
-    let kind = match (options.kind, grid) {
+    // Oriented normals of the kept points: needed to tell the kinds apart and for closed ones.
+    let oriented = (grid.is_none() && options.kind != Some(SurfaceKind::Open))
+        .then(|| oriented_normals(&kept, &frame, options.neighbours));
+    let kind = match (options.kind, &oriented) {
         (Some(kind), _) => kind,
-        (None, Some(_)) => SurfaceKind::Open,
-        (None, None) => detect_kind(&kept, &frame, options.neighbours),
+        (None, Some((_, normals))) => detect_kind(normals, &frame),
+        (None, None) => SurfaceKind::Open,
     };
-    let mesh = match kind {
-        SurfaceKind::Open => open_mesh(points, grid, &inlier, &spacing, &frame, options)?,
-        SurfaceKind::Closed => closed_mesh(&kept, &spacing, &inlier, options)?,
+    let mesh = match (kind, oriented) {
+        (SurfaceKind::Closed, Some((tree, normals))) => {
+            closed_mesh(&kept, &normals, &tree, &spacing, &inlier, options)?
+        }
+        _ => open_mesh(points, grid, &inlier, &spacing, &frame, options)?,
     };
     Ok(Reconstruction {
         mesh,
@@ -238,13 +243,22 @@ fn inliers(spacing: &[f64], ratio: Option<f64>) -> Vec<bool> {
     spacing.iter().map(|&s| s <= limit).collect()
 }
 
-/// Open or closed, from how the oriented normals sit against the best-fit plane.
-fn detect_kind(points: &[Point3], frame: &normals::Frame, k: usize) -> SurfaceKind {
+/// A kd-tree over `points` and their PCA normals, oriented consistently.
+fn oriented_normals(
+    points: &[Point3],
+    frame: &normals::Frame,
+    k: usize,
+) -> (Neighbours, Vec<Vec3>) {
     let tree = Neighbours::new(points);
-    let axis = frame.axes[0];
-    let mut n = normals::pca_normals(points, &tree, k, axis);
+    let mut n = normals::pca_normals(points, &tree, k, frame.axes[0]);
     normals::orient(points, &mut n, &tree, k);
-    let up = n.iter().filter(|v| v.dot(axis) > 0.0).count() as f64 / n.len() as f64;
+    (tree, n)
+}
+
+/// Open or closed, from how the oriented normals sit against the best-fit plane.
+fn detect_kind(normals: &[Vec3], frame: &normals::Frame) -> SurfaceKind {
+    let axis = frame.axes[0];
+    let up = normals.iter().filter(|v| v.dot(axis) > 0.0).count() as f64 / normals.len() as f64;
     if up.max(1.0 - up) >= OPEN_FRACTION {
         SurfaceKind::Open
     } else {
@@ -274,6 +288,8 @@ fn open_mesh(
 
 fn closed_mesh(
     kept: &[Point3],
+    normals: &[Vec3],
+    tree: &Neighbours,
     spacing: &[f64],
     inlier: &[bool],
     options: &ReconstructOptions,
@@ -283,15 +299,12 @@ fn closed_mesh(
         .zip(inlier)
         .filter_map(|(s, &k)| k.then_some(*s))
         .collect();
-    let tree = Neighbours::new(kept);
-    let frame = normals::frame(kept.iter().copied());
-    let mut n = normals::pca_normals(kept, &tree, options.neighbours, frame.axes[0]);
-    normals::orient(kept, &mut n, &tree, options.neighbours);
     let mut cell = options.cell_size * median(&kept_spacing);
     if cell <= 0.0 {
-        cell = frame.values[2].sqrt() * 1e-2;
+        // Mostly duplicated points: fall back to a hundredth of the spread.
+        cell = normals::frame(kept.iter().copied()).values[2].sqrt() * 1e-2;
     }
-    let (positions, tris) = closed::contour(kept, &n, &tree, cell, BAND_CELLS);
+    let (positions, tris) = closed::contour(kept, normals, tree, cell, BAND_CELLS);
     let tris = cleanup::manifold_part(tris, positions.len());
     if tris.is_empty() {
         return Err(ReconstructError::NoSurface);

@@ -7,6 +7,7 @@ mod export_samples;
 mod fit;
 mod fit_curve;
 mod info;
+mod reconstruct;
 mod simplify;
 mod subdiv;
 
@@ -34,6 +35,9 @@ enum Command {
     /// Simplify a mesh by quadric error metrics to a target vertex count (the initial control
     /// mesh of a fit), timed, with its distance to the input.
     Simplify(simplify::Args),
+    /// Build a manifold mesh from bare points (range grid, Delaunay or implicit surface),
+    /// timed, with the points' distance to it.
+    Reconstruct(reconstruct::Args),
     /// Refine a control mesh with a subdivision scheme (optionally to limit positions).
     Subdiv(subdiv::Args),
     /// Fit a subdivision surface to a scan by geometric iteration.
@@ -47,6 +51,7 @@ fn main() -> ExitCode {
         Command::FitCurve(args) => fit_curve::run(args),
         Command::ExportSamples(args) => export_samples::run(args),
         Command::Simplify(args) => simplify::run(args),
+        Command::Reconstruct(args) => reconstruct::run(args),
         Command::Subdiv(args) => subdiv::run(args),
         Command::Fit(args) => fit::run(args),
     };
