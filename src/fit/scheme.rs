@@ -39,8 +39,14 @@ impl ControlSurface for SubdivSurface {
         surface_of(self.scheme(), control)
     }
 
+    /// Loop and Catmull–Clark patches are the control faces. Doo–Sabin patches sit at
+    /// (face, vertex) sites whose face the surface does not expose, so they report no face
+    /// (`usize::MAX`): Doo–Sabin fits run without refinement.
     fn patch_face(&self, patch: u32) -> usize {
-        patch as usize
+        match self.scheme() {
+            Scheme::DooSabin => usize::MAX,
+            _ => patch as usize,
+        }
     }
 
     /// Loop: red–green splitting with Loop's masks. Quad schemes: one refinement step of the

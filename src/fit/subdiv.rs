@@ -25,7 +25,8 @@ pub trait ControlSurface: LimitSurface + Sized {
     /// The surface of the same scheme over `control` (new connectivity).
     fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError>;
 
-    /// The face of [`ControlSurface::control_polygons`] that `patch` belongs to.
+    /// The face of [`ControlSurface::control_polygons`] that `patch` belongs to; an index past
+    /// the last face means "no single face" (such patches are never refined).
     fn patch_face(&self, patch: u32) -> usize;
 
     /// Splits the `marked` faces of `control` (one flag per face) and what conformity needs
