@@ -1,5 +1,60 @@
 #!/usr/bin/env bash
-# Runs every test of geofit. Installs what it needs first; fast when it is already installed.
+# Runs every test of geofit: formatting, clippy (native and wasm32), the native tests (unit,
+# integration, doc), the wasm build, the browser tests (tests/e2e/*.mjs in Debian chromium, both
+# WebGL2 and WebGPU) and the Python interop tests (tests/interop/*.py). Installs what it needs
+# first; fast when it is already installed. Prints how long each step took.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo test --release
+
+declare -a timings=()
+step() {
+    local name=$1 start end
+    shift
+    printf '\n=== %s\n' "$name"
+    start=$(date +%s)
+    "$@"
+    end=$(date +%s)
+    timings+=("$(printf '%5ss  %s' $((end - start)) "$name")")
+}
+
+run_e2e() {
+    shopt -s nullglob
+    local files=(tests/e2e/*.mjs)
+    if ((${#files[@]} == 0)); then
+        echo "no browser tests"
+        return
+    fi
+    node --test --test-concurrency=1 "${files[@]}"
+}
+
+run_interop() {
+    shopt -s nullglob
+    local files=(tests/interop/*.py)
+    if ((${#files[@]} == 0)); then
+        echo "no interop tests"
+        return
+    fi
+    cargo build --release --bins
+    if [[ ! -x .venv/bin/python ]]; then
+        python3 -m venv .venv
+    fi
+    .venv/bin/pip install --quiet --disable-pip-version-check pytest
+    if [[ -f tests/interop/requirements.txt ]]; then
+        .venv/bin/pip install --quiet --disable-pip-version-check -r tests/interop/requirements.txt
+    fi
+    GEOFIT_BIN="$PWD/target/release/geofit" .venv/bin/python -m pytest -q tests/interop
+}
+
+total_start=$(date +%s)
+step "install" bash scripts/install.sh --browser
+step "cargo fmt --check" cargo fmt --check
+step "clippy native" cargo clippy --all-targets -- -D warnings
+step "clippy wasm32" cargo clippy --target wasm32-unknown-unknown --lib -- -D warnings
+step "cargo test --release" cargo test --release
+step "wasm build" bash scripts/build-wasm.sh
+step "browser tests" run_e2e
+step "interop tests" run_interop
+
+printf '\n=== timings\n'
+printf '%s\n' "${timings[@]}"
+printf '%5ss  total\n' $(($(date +%s) - total_start))

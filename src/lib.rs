@@ -16,6 +16,8 @@
 //! | [`io`] | readers and writers for point and mesh files |
 //! | [`cloud`] | bare point clouds to meshes (range grid, Delaunay, implicit surface) |
 //! | [`export`] | IGES and STEP export of B-spline / NURBS curves and surfaces |
+//! | [`render`] | the wgpu viewer (GPU part on `wasm32` only) and its f32 draw buffers |
+//! | `wasm` | JavaScript bindings (`wasm32` only) |
 //!
 //! The core is plain Rust with f64 maths and is tested natively with `cargo test`; the renderer
 //! and the wasm bindings sit behind the `wasm32` target.
@@ -26,5 +28,8 @@ pub mod fit;
 pub mod geom;
 pub mod io;
 pub mod mesh;
+pub mod render;
 pub mod spline;
 pub mod subdiv;
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;

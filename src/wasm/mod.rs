@@ -1,0 +1,18 @@
+//! JavaScript bindings: thin `#[wasm_bindgen]` handles over the core, one file per handle.
+//! Names are camelCase on the JavaScript side; bulk data crosses as typed arrays; every error
+//! reaches JavaScript as a thrown `Error` carrying the Rust error's message.
+
+mod scan;
+mod viewer;
+
+pub use scan::{load_file, LoadedScan};
+pub use viewer::Viewer;
+
+use wasm_bindgen::prelude::wasm_bindgen;
+
+/// Runs once when the module is instantiated: panics (which no code path relies on) at least
+/// reach the console with their message.
+#[wasm_bindgen(start)]
+pub fn start() {
+    console_error_panic_hook::set_once();
+}

@@ -1,0 +1,73 @@
+//! `loadFile` and the `LoadedScan` handle: a parsed point or mesh file, ready to draw.
+
+use crate::io::{self, LoadedFile};
+use crate::render::buffers;
+use wasm_bindgen::prelude::*;
+
+/// A point or mesh file read by the core: its counts, bounding box and draw buffers.
+#[wasm_bindgen]
+pub struct LoadedScan {
+    file: LoadedFile,
+}
+
+/// Reads a point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS) from its bytes. `name` is the file
+/// name, a hint for the format. Throws an `Error` saying what is wrong and where.
+#[wasm_bindgen(js_name = loadFile)]
+pub fn load_file(bytes: &[u8], name: &str) -> Result<LoadedScan, JsError> {
+    let file = io::read_bytes(bytes, Some(name))?;
+    Ok(LoadedScan { file })
+}
+
+#[wasm_bindgen]
+impl LoadedScan {
+    /// The format the file was parsed as: "ply", "obj", "stl" or "xyz".
+    #[wasm_bindgen(getter)]
+    pub fn format(&self) -> Result<JsValue, JsError> {
+        Ok(serde_wasm_bindgen::to_value(&self.file.format)?)
+    }
+
+    /// Number of points (vertices).
+    #[wasm_bindgen(getter, js_name = numPoints)]
+    pub fn num_points(&self) -> usize {
+        self.file.mesh.num_vertices()
+    }
+
+    /// Number of triangles after triangulating polygons.
+    #[wasm_bindgen(getter, js_name = numTriangles)]
+    pub fn num_triangles(&self) -> usize {
+        self.file.mesh.num_triangles()
+    }
+
+    /// Point positions for drawing: `x, y, z` per point (f32).
+    pub fn positions(&self) -> Vec<f32> {
+        buffers::to_f32_xyz(self.file.mesh.positions())
+    }
+
+    /// Smooth vertex normals for drawing the triangles: `x, y, z` per point (f32).
+    pub fn normals(&self) -> Vec<f32> {
+        buffers::vertex_normals(self.file.mesh.positions(), &self.file.mesh.triangles())
+    }
+
+    /// Triangle vertex indices, three per triangle.
+    pub fn indices(&self) -> Vec<u32> {
+        self.file.mesh.triangles().into_iter().flatten().collect()
+    }
+
+    /// Smallest corner of the bounding box, `[x, y, z]` (f64), or empty when there are no points.
+    #[wasm_bindgen(js_name = bboxMin)]
+    pub fn bbox_min(&self) -> Vec<f64> {
+        self.file
+            .mesh
+            .bbox()
+            .map_or(Vec::new(), |b| b.min.to_array().to_vec())
+    }
+
+    /// Largest corner of the bounding box, `[x, y, z]` (f64), or empty when there are no points.
+    #[wasm_bindgen(js_name = bboxMax)]
+    pub fn bbox_max(&self) -> Vec<f64> {
+        self.file
+            .mesh
+            .bbox()
+            .map_or(Vec::new(), |b| b.max.to_array().to_vec())
+    }
+}

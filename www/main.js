@@ -1,0 +1,243 @@
+// The geofit demo page: loads a point or mesh file through the Rust readers (wasm) and draws it
+// with the wgpu viewer. The page opens with a bundled sample; a file picker and drag-and-drop load
+// others; a file that cannot be read leaves the previous one on screen and says why.
+import init, { Viewer, loadFile } from '../pkg/geofit.js';
+
+const DEFAULT_SAMPLE = 'samples/bunny.obj';
+// Height colours, low to high (sRGB): blue, teal, amber.
+const PALETTE = [
+  [0.15, 0.35, 0.95],
+  [0.10, 0.75, 0.70],
+  [1.00, 0.62, 0.10],
+];
+
+const el = (id) => document.getElementById(id);
+const ui = {
+  canvas: el('view'),
+  file: el('file'),
+  error: el('error'),
+  fileName: el('file-name'),
+  points: el('num-points'),
+  triangles: el('num-triangles'),
+  backend: el('backend'),
+  showPoints: el('show-points'),
+  showMesh: el('show-mesh'),
+  showWireframe: el('show-wireframe'),
+};
+
+let viewer = null;
+let frameRequest = 0;
+let framesDrawn = 0;
+
+/** Draws a frame at the next animation frame (once, however often it is asked for). */
+function requestRender() {
+  if (!viewer || frameRequest) return;
+  frameRequest = requestAnimationFrame(() => {
+    frameRequest = 0;
+    viewer.render();
+    framesDrawn += 1;
+    document.body.dataset.frames = String(framesDrawn);
+  });
+}
+
+function setState(state) {
+  document.body.dataset.state = state;
+}
+
+function showError(message) {
+  ui.error.textContent = message;
+  ui.error.hidden = false;
+}
+
+function clearError() {
+  ui.error.textContent = '';
+  ui.error.hidden = true;
+}
+
+/** Colours each point by its height (y) through PALETTE. */
+function heightColors(positions) {
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (let i = 1; i < positions.length; i += 3) {
+    lo = Math.min(lo, positions[i]);
+    hi = Math.max(hi, positions[i]);
+  }
+  const span = hi > lo ? hi - lo : 1;
+  const colors = new Float32Array(positions.length);
+  const last = PALETTE.length - 1;
+  for (let i = 0; i < positions.length; i += 3) {
+    const t = ((positions[i + 1] - lo) / span) * last;
+    const k = Math.min(Math.floor(t), last - 1);
+    const f = t - k;
+    for (let c = 0; c < 3; c += 1) {
+      colors[i + c] = PALETTE[k][c] * (1 - f) + PALETTE[k + 1][c] * f;
+    }
+  }
+  return colors;
+}
+
+/** Parses `bytes` with the Rust readers and shows the result; on error keeps what was shown. */
+function show(bytes, name) {
+  let scan;
+  try {
+    scan = loadFile(bytes, name);
+  } catch (e) {
+    showError(`Could not load ${name}: ${e?.message ?? e}`);
+    setState('error');
+    return false;
+  }
+  try {
+    const positions = scan.positions();
+    const indices = scan.indices();
+    const normals = indices.length > 0 ? scan.normals() : new Float32Array();
+    const meshPositions = indices.length > 0 ? positions : new Float32Array();
+    if (viewer) {
+      viewer.setPoints(positions, heightColors(positions));
+      viewer.setMesh(meshPositions, normals, indices);
+      viewer.fitView();
+    }
+    ui.fileName.textContent = name;
+    ui.points.textContent = scan.numPoints.toLocaleString('en-US');
+    ui.triangles.textContent = scan.numTriangles.toLocaleString('en-US');
+    clearError();
+    setState('ready');
+    requestRender();
+    return true;
+  } catch (e) {
+    showError(`Could not show ${name}: ${e?.message ?? e}`);
+    setState('error');
+    return false;
+  } finally {
+    scan.free();
+  }
+}
+
+async function openFile(file) {
+  const bytes = new Uint8Array(await file.arrayBuffer());
+  show(bytes, file.name);
+}
+
+function updateLayers() {
+  viewer?.setLayers(
+    ui.showPoints.checked,
+    ui.showMesh.checked,
+    ui.showWireframe.checked,
+    true,
+  );
+  requestRender();
+}
+
+function resize() {
+  if (!viewer) return;
+  const { clientWidth, clientHeight } = ui.canvas;
+  viewer.resize(clientWidth, clientHeight, window.devicePixelRatio || 1);
+  requestRender();
+}
+
+/** Orbit camera: drag rotates, shift-drag or right-drag pans, the wheel zooms, double-click or F fits. */
+function bindCamera() {
+  const c = ui.canvas;
+  let last = null;
+  c.addEventListener('contextmenu', (e) => e.preventDefault());
+  c.addEventListener('pointerdown', (e) => {
+    c.setPointerCapture(e.pointerId);
+    c.focus();
+    last = { x: e.clientX, y: e.clientY };
+  });
+  c.addEventListener('pointermove', (e) => {
+    if (!last || !viewer) return;
+    const dx = e.clientX - last.x;
+    const dy = e.clientY - last.y;
+    last = { x: e.clientX, y: e.clientY };
+    const panning = e.shiftKey || (e.buttons & 2) !== 0 || (e.buttons & 4) !== 0;
+    if (panning) viewer.pan(dx, dy);
+    else viewer.orbit(dx, dy);
+    requestRender();
+  });
+  const end = () => {
+    last = null;
+  };
+  c.addEventListener('pointerup', end);
+  c.addEventListener('pointercancel', end);
+  c.addEventListener(
+    'wheel',
+    (e) => {
+      e.preventDefault();
+      const scale = e.deltaMode === 1 ? 33 : e.deltaMode === 2 ? 400 : 1;
+      viewer?.zoom(e.deltaY * scale);
+      requestRender();
+    },
+    { passive: false },
+  );
+  const fit = () => {
+    viewer?.fitView();
+    requestRender();
+  };
+  c.addEventListener('dblclick', fit);
+  window.addEventListener('keydown', (e) => {
+    const typing = e.target instanceof HTMLInputElement && e.target.type !== 'checkbox';
+    if (!typing && (e.key === 'f' || e.key === 'F') && !e.ctrlKey && !e.metaKey) fit();
+  });
+}
+
+function bindFiles() {
+  ui.file.addEventListener('change', () => {
+    const [file] = ui.file.files;
+    if (file) openFile(file);
+    ui.file.value = '';
+  });
+  let depth = 0;
+  window.addEventListener('dragenter', (e) => {
+    e.preventDefault();
+    depth += 1;
+    document.body.classList.add('dragging');
+  });
+  window.addEventListener('dragleave', () => {
+    depth = Math.max(0, depth - 1);
+    if (depth === 0) document.body.classList.remove('dragging');
+  });
+  window.addEventListener('dragover', (e) => e.preventDefault());
+  window.addEventListener('drop', (e) => {
+    e.preventDefault();
+    depth = 0;
+    document.body.classList.remove('dragging');
+    const file = e.dataTransfer?.files?.[0];
+    if (file) openFile(file);
+  });
+}
+
+async function main() {
+  await init();
+  bindFiles();
+  bindCamera();
+  for (const box of [ui.showPoints, ui.showMesh, ui.showWireframe]) {
+    box.addEventListener('change', updateLayers);
+  }
+  const ratio = window.devicePixelRatio || 1;
+  ui.canvas.width = Math.max(1, Math.round(ui.canvas.clientWidth * ratio));
+  ui.canvas.height = Math.max(1, Math.round(ui.canvas.clientHeight * ratio));
+  try {
+    viewer = await Viewer.create(ui.canvas);
+    ui.backend.textContent = viewer.backend;
+    document.body.dataset.backend = viewer.backend;
+  } catch (e) {
+    ui.backend.textContent = 'unavailable';
+    showError(`Cannot draw: ${e?.message ?? e}. Files can still be read.`);
+  }
+  new ResizeObserver(resize).observe(ui.canvas);
+  window.addEventListener('resize', resize);
+  resize();
+  updateLayers();
+  const response = await fetch(DEFAULT_SAMPLE);
+  if (!response.ok) {
+    showError(`Could not fetch the sample ${DEFAULT_SAMPLE}: HTTP ${response.status}`);
+    setState('error');
+    return;
+  }
+  show(new Uint8Array(await response.arrayBuffer()), DEFAULT_SAMPLE.split('/').pop());
+}
+
+main().catch((e) => {
+  showError(`The page failed to start: ${e?.message ?? e}`);
+  setState('error');
+});
