@@ -126,12 +126,12 @@ impl ControlMesh {
                 self.vert_he[v] = h as u32;
             }
         }
-        for v in 0..self.positions.len() {
+        for (v, &expected) in outgoing.iter().enumerate().take(self.positions.len()) {
             if self.vert_he[v] == NONE {
                 continue;
             }
             let fan = self.outgoing(v as u32).count();
-            if fan != outgoing[v] {
+            if fan != expected {
                 let boundary_out = (0..self.origin.len())
                     .filter(|&h| self.origin[h] == v as u32 && self.twin[h] == NONE)
                     .count();
@@ -554,9 +554,9 @@ impl ControlMesh {
             for h in self.face_half_edges(f) {
                 let (a, b) = (self.origin(h), self.target(h));
                 let key = (a.min(b), a.max(b));
-                if !mids.contains_key(&key) {
+                if let std::collections::hash_map::Entry::Vacant(slot) = mids.entry(key) {
                     let m = (self.positions.len() + created.len()) as u32;
-                    mids.insert(key, m);
+                    slot.insert(m);
                     created.push((m, key.0, key.1));
                 }
             }

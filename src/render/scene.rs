@@ -5,13 +5,8 @@ use super::pipeline::{Pipelines, Uniforms, DEPTH_FORMAT};
 use super::{OrbitCamera, RenderError};
 use glam::Vec3;
 
-/// Background colour, linear RGB (a dark slate).
-const BACKGROUND: wgpu::Color = wgpu::Color {
-    r: 0.012,
-    g: 0.016,
-    b: 0.024,
-    a: 1.0,
-};
+/// Background colour, sRGB (a dark slate), as the page shows it on every backend.
+const BACKGROUND: [f64; 3] = [0.11, 0.13, 0.17];
 /// Mesh colour, sRGB: a light clay.
 const MESH_COLOR: [f32; 4] = [0.80, 0.76, 0.70, 1.0];
 /// Wireframe colour, sRGB: dark grey.
@@ -305,7 +300,7 @@ impl Renderer {
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(BACKGROUND),
+                        load: wgpu::LoadOp::Clear(self.clear_color()),
                         store: wgpu::StoreOp::Store,
                     },
                 })],
@@ -359,6 +354,17 @@ impl Renderer {
             self.points.bind(pass);
             pass.draw(0..6, 0..self.points.count);
         }
+    }
+
+    /// The background as the colour target stores it: sRGB values as they are when the shaders
+    /// encode by hand, linear values when the target encodes.
+    fn clear_color(&self) -> wgpu::Color {
+        let [r, g, b] = if self.gpu.encodes_srgb_by_hand() {
+            BACKGROUND
+        } else {
+            BACKGROUND.map(srgb_to_linear)
+        };
+        wgpu::Color { r, g, b, a: 1.0 }
     }
 
     fn write_uniforms(&self) {
@@ -466,4 +472,13 @@ fn depth_view(gpu: &Gpu) -> wgpu::TextureView {
             view_formats: &[],
         })
         .create_view(&Default::default())
+}
+
+/// The sRGB transfer function, inverted (as in `shaders/scene.wgsl`).
+fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }

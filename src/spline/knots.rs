@@ -190,8 +190,8 @@ fn derivative_rows(
         }
     }
     let mut factor = p as f64;
-    for k in 1..=d {
-        for v in out[k].iter_mut().take(p + 1) {
+    for (k, row) in out.iter_mut().enumerate().take(d + 1).skip(1) {
+        for v in row.iter_mut().take(p + 1) {
             *v *= factor;
         }
         factor *= (p - k) as f64;

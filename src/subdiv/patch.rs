@@ -669,7 +669,7 @@ impl Graph {
             .map(|r| {
                 let mut nz = gather.row(r);
                 match (nz.next(), nz.next()) {
-                    (Some((j, w)), None) if w == 1.0 => Some(j as u32),
+                    (Some((j, 1.0)), None) => Some(j as u32),
                     _ => None,
                 }
             })
