@@ -157,9 +157,9 @@ fn regular_patch_is_the_bicubic_bspline() {
     for &(u, v) in &[(0.0, 0.0), (0.3, 0.7), (1.0, 0.5), (0.5, 0.5)] {
         let (bu, bv) = (bspline(u), bspline(v));
         let mut q = Point3::ZERO;
-        for b in 0..4 {
-            for a in 0..4 {
-                q += p(i0 + a - 1, j0 + b - 1) * (bu[a] * bv[b]);
+        for (b, wv) in bv.iter().enumerate() {
+            for (a, wu) in bu.iter().enumerate() {
+                q += p(i0 + a - 1, j0 + b - 1) * (wu * wv);
             }
         }
         let e = s.eval(SurfaceParam {
