@@ -219,6 +219,8 @@ async function main() {
   try {
     viewer = await Viewer.create(ui.canvas);
     ui.backend.textContent = viewer.backend;
+    // A handle for the browser console and the end-to-end tests.
+    window.geofit = { viewer, loadFile, requestRender };
     document.body.dataset.backend = viewer.backend;
   } catch (e) {
     ui.backend.textContent = 'unavailable';

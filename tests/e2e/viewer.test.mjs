@@ -89,11 +89,13 @@ for (const backend of BACKENDS) {
     let server;
     let browser;
     let page;
+    let pageUrl;
     const problems = [];
 
     before(async () => {
       const started = await startServer(0);
       server = started.server;
+      pageUrl = started.url;
       browser = await chromium.launch({
         executablePath: CHROMIUM,
         headless: true,
@@ -167,6 +169,148 @@ for (const backend of BACKENDS) {
       );
       await nextFrame(page, frames);
       assert.equal(await page.isHidden('#error'), true, 'the error clears on the next good file');
+    });
+
+    test('wireframe, orbit, zoom and fit change the view as expected', async () => {
+      const frames = () => framesDrawn(page);
+      const base = await canvasPixels(page, `camera-0-fitted-${backend.name}.png`);
+
+      let n = await frames();
+      await page.check('#show-wireframe');
+      await nextFrame(page, n);
+      const wired = await canvasPixels(page, `camera-1-wireframe-${backend.name}.png`);
+      assert.ok(wired.clay < 0.95 * base.clay, `wireframe hides no surface: ${wired.clay} vs ${base.clay}`);
+      n = await frames();
+      await page.uncheck('#show-wireframe');
+      await nextFrame(page, n);
+
+      const box = await page.locator('#view').boundingBox();
+      const cx = box.x + box.width / 2;
+      const cy = box.y + box.height / 2;
+      n = await frames();
+      await page.mouse.move(cx, cy);
+      await page.mouse.down();
+      await page.mouse.move(cx + 120, cy + 30, { steps: 4 });
+      await page.mouse.up();
+      await nextFrame(page, n);
+      const turned = await canvasPixels(page, `camera-2-orbited-${backend.name}.png`);
+      assert.notDeepEqual(turned, base, 'dragging changed nothing');
+
+      n = await frames();
+      await page.mouse.wheel(0, -400);
+      await nextFrame(page, n);
+      const zoomed = await canvasPixels(page, `camera-3-zoomed-${backend.name}.png`);
+      assert.ok(zoomed.drawn > 1.2 * turned.drawn, `zooming in did not enlarge: ${zoomed.drawn} vs ${turned.drawn}`);
+
+      n = await frames();
+      await page.dblclick('#view');
+      await nextFrame(page, n);
+      const fitted = await canvasPixels(page, `camera-4-refitted-${backend.name}.png`);
+      assert.ok(
+        Math.abs(fitted.drawn - base.drawn) <= 0.01 * base.drawn,
+        `double-click did not restore the fitted view: ${fitted.drawn} vs ${base.drawn}`,
+      );
+    });
+
+    test('bad data at the JavaScript API throws errors with messages', async () => {
+      const messages = await page.evaluate(() => {
+        const { viewer, loadFile } = window.geofit;
+        const caught = (f) => {
+          try {
+            f();
+            return 'no error';
+          } catch (e) {
+            return e instanceof Error ? e.message : `not an Error: ${e}`;
+          }
+        };
+        const three = new Float32Array([0, 0, 0]);
+        return [
+          caught(() => loadFile(new Uint8Array(), 'empty.xyz')),
+          caught(() => viewer.setPoints(new Float32Array([1, 2]), new Float32Array([1, 2]))),
+          caught(() => viewer.setPoints(new Float32Array([0, NaN, 0]), three)),
+          caught(() => viewer.setMesh(three, three, new Uint32Array([0, 0, 7]))),
+          caught(() => viewer.setLines(new Float32Array(9), new Float32Array(9))),
+        ];
+      });
+      assert.match(messages[0], /empty/);
+      assert.match(messages[1], /point positions has 2 values/);
+      assert.match(messages[2], /point positions value 1 is not finite/);
+      assert.match(messages[3], /index 7 .* out of range for 1 vertices/);
+      assert.match(messages[4], /multiple of 6/);
+    });
+
+    test('line sets draw in their colours', async () => {
+      const n = await framesDrawn(page);
+      await page.evaluate(() => {
+        const { viewer } = window.geofit;
+        // A red cross through the view's centre, drawn over the (hidden) scene.
+        viewer.setLayers(false, false, false, true);
+        const c = [-0.0168, 0.11, 0.0015];
+        const d = 0.08;
+        const pos = [];
+        for (let axis = 0; axis < 3; axis += 1) {
+          for (let k = -4; k <= 4; k += 1) {
+            for (const s of [-d, d]) {
+              const p = [...c];
+              p[axis] += s;
+              p[(axis + 1) % 3] += k * 0.0005;
+              pos.push(...p);
+            }
+          }
+        }
+        viewer.setLines(new Float32Array(pos), new Float32Array(pos.length).map((_, i) => (i % 3 === 0 ? 1 : 0)));
+        window.geofit.requestRender();
+      });
+      await nextFrame(page, n);
+      const png = await page.locator('#view').screenshot();
+      writeFileSync(join(ARTIFACTS, `lines-${backend.name}.png`), png);
+      const red = await page.evaluate(async (b64) => {
+        const img = new Image();
+        img.src = `data:image/png;base64,${b64}`;
+        await img.decode();
+        const c = new OffscreenCanvas(img.width, img.height);
+        const ctx = c.getContext('2d');
+        ctx.drawImage(img, 0, 0);
+        const { data } = ctx.getImageData(0, 0, img.width, img.height);
+        let count = 0;
+        for (let i = 0; i < data.length; i += 4) {
+          if (data[i] > 200 && data[i + 1] < 60 && data[i + 2] < 60) count += 1;
+        }
+        return count;
+      }, png.toString('base64'));
+      assert.ok(red > 200, `only ${red} red line pixels`);
+      await page.evaluate(() => {
+        window.geofit.viewer.setLines(new Float32Array(), new Float32Array());
+      });
+      await page.uncheck('#show-points');
+      await page.check('#show-points');
+    });
+
+    test('a narrow window at device pixel ratio 2 keeps a sharp, working view', async () => {
+      const small = await browser.newPage({ viewport: { width: 360, height: 640 }, deviceScaleFactor: 2 });
+      try {
+        await small.goto(pageUrl);
+        await small.waitForSelector('body[data-state="ready"]', { timeout: TIMEOUT_MS });
+        await nextFrame(small, 0);
+        const m = await small.evaluate(() => {
+          const c = document.getElementById('view');
+          return {
+            css: [c.clientWidth, c.clientHeight],
+            px: [c.width, c.height],
+            scrollWidth: document.documentElement.scrollWidth,
+          };
+        });
+        assert.deepEqual(m.px, [m.css[0] * 2, m.css[1] * 2], JSON.stringify(m));
+        assert.ok(m.css[1] > 200, `the view is only ${m.css[1]} px tall`);
+        assert.ok(m.scrollWidth <= 360, `the page scrolls sideways: ${m.scrollWidth}`);
+        assert.equal(await small.textContent('#num-points'), '2,007');
+        await small.locator('#view').screenshot({ path: join(ARTIFACTS, `narrow-dpr2-${backend.name}.png`) });
+      } finally {
+        await small.close();
+      }
+    });
+
+    test('the page logged no errors', () => {
       assert.deepEqual(problems, []);
     });
   });
