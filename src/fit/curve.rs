@@ -34,6 +34,10 @@ pub struct CurveFitOptions {
     pub stall_ratio: f64,
     /// Acceleration of the iteration [Anderson, depth 5].
     pub acceleration: Acceleration,
+    /// Share of the spans above tolerance that get a knot per refinement, worst first, in
+    /// (0, 1] [0.34]. Smaller shares give fewer control points for more iterations (bunny
+    /// section at E_max 0.01 %: 1.0 → 468 control points in 53 iterations, 0.34 → 350 in 99).
+    pub refine_fraction: f64,
     /// Newton iterations per foot point and fitting iteration [8].
     pub newton_iter: usize,
 }
@@ -50,6 +54,7 @@ impl Default for CurveFitOptions {
             refine_interval: 8,
             stall_ratio: 0.02,
             acceleration: Acceleration::default(),
+            refine_fraction: 0.34,
             newton_iter: 8,
         }
     }
@@ -481,30 +486,44 @@ impl CurveFitter {
         pct / 100.0 * self.data.diagonal
     }
 
-    /// Inserts a knot at the middle of every span whose largest error exceeds the tolerance,
-    /// worst first, within the control-point budget. Returns whether any was inserted.
+    /// Inserts one knot in every span whose largest error exceeds the tolerance, worst first,
+    /// within the control-point budget: at the foot parameter of the span's worst point, kept
+    /// within the middle half of the span so no knot interval becomes tiny. Returns whether
+    /// any was inserted.
     fn refine(&mut self) -> Result<bool, FitError> {
         let tol = self.local_tolerance();
         let knots = self.curve.knots().knots().to_vec();
-        let mut worst: Vec<(usize, f64)> = Vec::new();
+        // Per span: (span, largest error, its foot parameter).
+        let mut per_span: Vec<Option<(f64, f64)>> = vec![None; knots.len()];
         for (&u, &e) in self.params.iter().zip(&self.errors) {
             let span = self.curve.knots().find_span(u);
-            match worst.iter_mut().find(|(s, _)| *s == span) {
-                Some(w) => w.1 = w.1.max(e.abs()),
-                None => worst.push((span, e.abs())),
+            if per_span[span].is_none_or(|(w, _)| e.abs() > w) {
+                per_span[span] = Some((e.abs(), u));
             }
         }
-        worst.retain(|&(_, e)| e > tol);
+        let mut worst: Vec<(usize, f64, f64)> = per_span
+            .iter()
+            .enumerate()
+            .filter_map(|(s, w)| w.map(|(e, u)| (s, e, u)))
+            .filter(|&(_, e, _)| e > tol)
+            .collect();
         worst.sort_by(|a, b| b.1.total_cmp(&a.1));
         let budget = self
             .options
             .max_control
             .unwrap_or(self.data.points.len())
             .saturating_sub(self.curve.control_points().len());
-        worst.truncate(budget);
-        for &(span, _) in &worst {
-            let mid = 0.5 * (knots[span] + knots[span + 1]);
-            self.curve = self.curve.insert_knot(mid)?;
+        // Only the worst share of the offending spans: the others often meet the tolerance
+        // after a few more iterations, once their neighbours have more freedom.
+        let share = (worst.len() as f64 * self.options.refine_fraction).ceil() as usize;
+        worst.truncate(budget.min(share.max(1)));
+        for &(span, _, u) in &worst {
+            let (lo, hi) = (knots[span], knots[span + 1]);
+            let at = self
+                .curve
+                .normalize_param(u)
+                .clamp(lo + 0.25 * (hi - lo), hi - 0.25 * (hi - lo));
+            self.curve = self.curve.insert_knot(at)?;
         }
         if !worst.is_empty() {
             self.accel.reset();
