@@ -63,9 +63,9 @@ fn regular_grid_limit_is_the_biquadratic_bspline() {
         let (i, j) = ((x - 0.5).floor() as usize, (y - 0.5).floor() as usize);
         let (bu, bv) = (quadratic(x - 0.5 - i as f64), quadratic(y - 0.5 - j as f64));
         let mut q = Point3::ZERO;
-        for b in 0..3 {
-            for a in 0..3 {
-                q += p(i + a - 1 + 1, j + b - 1 + 1) * (bu[a] * bv[b]);
+        for (b, wv) in bv.iter().enumerate() {
+            for (a, wu) in bu.iter().enumerate() {
+                q += p(i + a - 1 + 1, j + b - 1 + 1) * (wu * wv);
             }
         }
         q
