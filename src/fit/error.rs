@@ -51,4 +51,31 @@ pub enum FitError {
     /// The subdivision library rejected the control mesh.
     #[error(transparent)]
     Subdiv(#[from] crate::subdiv::SubdivError),
+    /// Projecting the points to parameterise them gives no usable parameter domain.
+    #[error("cannot parameterise the points: {reason}")]
+    DegenerateProjection {
+        /// What is degenerate, with the view direction.
+        reason: String,
+    },
+    /// The projection used for the parameters is not one-to-one: some points lie on a
+    /// fold-over (their projections coincide with other points' at a clearly different depth).
+    #[error(
+        "the projection is not one-to-one: {count} of {total} points lie on a fold-over \
+         (first: point {first}); choose another view direction or a base surface, or exclude \
+         or keep folded points"
+    )]
+    FoldedProjection {
+        /// Folded points.
+        count: usize,
+        /// All points.
+        total: usize,
+        /// Index of the first folded point.
+        first: usize,
+    },
+    /// The linear solver failed (the system is singular: raise the smoothing weights).
+    #[error("the least-squares system cannot be solved: {reason}")]
+    Solver {
+        /// The solver's message.
+        reason: String,
+    },
 }

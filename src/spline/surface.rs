@@ -341,30 +341,41 @@ impl BSplineSurface {
         let scale = (du_dom.1 - du_dom.0).max(dv_dom.1 - dv_dom.0);
         let mut iterations = 0;
         let mut converged = false;
+        let mut current = self.derivs(u, v, 2);
+        let mut dist_sq = (current.point() - p).length_squared();
         while iterations < opts.max_iterations {
             iterations += 1;
-            let d = self.derivs(u, v, 2);
-            let step = newton_step(&d, p);
-            let Some((su, sv)) = step else {
+            let Some((su, sv)) = newton_step(&current, p) else {
                 converged = true;
                 break;
             };
-            let nu = self.knots_u.clamp(u + su);
-            let nv = self.knots_v.clamp(v + sv);
+            // Backtracking: halve the step until the distance does not grow.
+            let mut t = 1.0;
+            let mut accepted = None;
+            for _ in 0..12 {
+                let nu = self.knots_u.clamp(u + t * su);
+                let nv = self.knots_v.clamp(v + t * sv);
+                let d = self.derivs(nu, nv, 2);
+                let dsq = (d.point() - p).length_squared();
+                if dsq <= dist_sq {
+                    accepted = Some((nu, nv, d, dsq));
+                    break;
+                }
+                t *= 0.5;
+            }
+            let Some((nu, nv, d, dsq)) = accepted else {
+                converged = true;
+                break;
+            };
             let moved = (nu - u).abs().max((nv - v).abs());
-            u = nu;
-            v = nv;
+            (u, v, current, dist_sq) = (nu, nv, d, dsq);
             if moved <= opts.param_tolerance * scale {
                 converged = true;
                 break;
             }
         }
-        let point = self.eval(u, v);
-        let dist_sq = if p.is_finite() {
-            (point - p).length_squared()
-        } else {
-            f64::MAX
-        };
+        let point = current.point();
+        let dist_sq = if p.is_finite() { dist_sq } else { f64::MAX };
         SurfaceNearest {
             u,
             v,

@@ -1,0 +1,455 @@
+//! UV parameterisation of scattered points for tensor-product surface fitting (SPEC §2).
+//!
+//! Each data point needs parameters (u, v) on the surface before a fit can start. They come
+//! from projecting the points along a view direction onto a plane (by default the plane of
+//! the two largest principal axes, so the view is the least-variance axis), or from the
+//! closest point on a user base surface. A projection is only usable where it is one-to-one:
+//! where the scan folds over (points whose projections coincide while their depths differ by
+//! more than the sampling allows) the parameters are wrong. Such points are detected and,
+//! by [`FoldPolicy`], reported as an error, excluded from the fit, or kept.
+
+use super::FitError;
+use crate::geom::{Point3, Vec3};
+use crate::spline::{BSplineSurface, NewtonOptions};
+use std::collections::HashMap;
+
+/// What to do with points on a fold-over of the projection.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FoldPolicy {
+    /// Fail with [`FitError::FoldedProjection`].
+    Fail,
+    /// Leave folded points out of the fit (they are still measured). The default.
+    #[default]
+    Exclude,
+    /// Fit folded points like all others; they are only counted.
+    Keep,
+}
+
+/// Options of [`parameterize`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct ParamOptions {
+    /// View direction to project along; `None` (default) takes the least-variance principal
+    /// axis of the points.
+    pub view: Option<Vec3>,
+    /// What folded points do. Default [`FoldPolicy::Exclude`].
+    pub fold_policy: FoldPolicy,
+    /// Two points of one projection cell whose depths differ by more than this many cell
+    /// sizes lie on different layers of a fold. Default 4.
+    pub fold_gap_cells: f64,
+}
+
+impl Default for ParamOptions {
+    fn default() -> Self {
+        ParamOptions {
+            view: None,
+            fold_policy: FoldPolicy::Exclude,
+            fold_gap_cells: 4.0,
+        }
+    }
+}
+
+impl ParamOptions {
+    /// Sets the view direction.
+    pub fn with_view(mut self, view: Vec3) -> Self {
+        self.view = Some(view);
+        self
+    }
+
+    /// Sets the fold policy.
+    pub fn with_fold_policy(mut self, policy: FoldPolicy) -> Self {
+        self.fold_policy = policy;
+        self
+    }
+}
+
+/// The plane points were projected onto: (u, v) ∈ [0, 1]² map to
+/// `origin + u · size_u · axis_u + v · size_v · axis_v`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProjectionFrame {
+    /// The corner of the parameter rectangle, (u, v) = (0, 0).
+    pub origin: Point3,
+    /// Unit direction of growing u.
+    pub axis_u: Vec3,
+    /// Unit direction of growing v.
+    pub axis_v: Vec3,
+    /// Unit view direction (the plane normal).
+    pub view: Vec3,
+    /// Extent of the points along `axis_u`.
+    pub size_u: f64,
+    /// Extent of the points along `axis_v`.
+    pub size_v: f64,
+}
+
+impl ProjectionFrame {
+    /// The point of the plane at (u, v) ∈ [0, 1]².
+    pub fn at(&self, u: f64, v: f64) -> Point3 {
+        self.origin + self.axis_u * (u * self.size_u) + self.axis_v * (v * self.size_v)
+    }
+}
+
+/// Parameters of every data point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameterization {
+    /// (u, v) of every point, in data order, in [0, 1]² for a plane or the base surface's
+    /// domain.
+    pub uv: Vec<[f64; 2]>,
+    /// Whether each point lies on a fold-over (not the main layer of its projection cell).
+    pub folded: Vec<bool>,
+    /// Number of folded points.
+    pub num_folded: usize,
+    /// The projection plane, when the points were projected onto a plane.
+    pub frame: Option<ProjectionFrame>,
+}
+
+impl Parameterization {
+    /// Whether point `i` takes part in the fit under `policy`.
+    pub fn is_active(&self, i: usize, policy: FoldPolicy) -> bool {
+        policy != FoldPolicy::Exclude || !self.folded[i]
+    }
+}
+
+/// Checks that there are at least `needed` points and that all are finite.
+pub fn check_points(points: &[Point3], needed: usize) -> Result<(), FitError> {
+    if points.len() < needed {
+        return Err(FitError::TooFewPoints {
+            found: points.len(),
+            needed,
+        });
+    }
+    match points.iter().position(|p| !p.is_finite()) {
+        Some(index) => Err(FitError::NonFinitePoint { index }),
+        None => Ok(()),
+    }
+}
+
+/// Parameters by projection onto a plane along `opts.view` (default: least-variance axis).
+/// Fails on fewer than 3 or non-finite points, on a zero or non-finite view direction, on
+/// points whose projection is degenerate (collinear, or a plane seen edge-on), and, under
+/// [`FoldPolicy::Fail`], on folded points.
+pub fn parameterize(points: &[Point3], opts: &ParamOptions) -> Result<Parameterization, FitError> {
+    check_points(points, 3)?;
+    let center = points.iter().copied().sum::<Point3>() / points.len() as f64;
+    let (values, axes) = principal_axes(points, center);
+    let scale = values[0].max(f64::MIN_POSITIVE);
+    let view = match opts.view {
+        Some(v) => {
+            let len = v.length();
+            if !(len.is_finite() && len > 0.0) {
+                return Err(FitError::InvalidOption {
+                    name: "view",
+                    reason: format!("the view direction {v} must be finite and non-zero"),
+                });
+            }
+            v / len
+        }
+        None => axes[2],
+    };
+    // In-plane axes: the principal axes with the view component removed.
+    let axis_u = (axes[0] - view * axes[0].dot(view)).try_normalize();
+    let axis_u = axis_u
+        .or_else(|| (axes[1] - view * axes[1].dot(view)).try_normalize())
+        .unwrap_or(Vec3::X);
+    let axis_v = view.cross(axis_u).normalize_or_zero();
+    let (axis_u, axis_v) = min_area_axes(points, center, axis_u, axis_v);
+    let proj: Vec<[f64; 3]> = points
+        .iter()
+        .map(|p| {
+            let d = *p - center;
+            [d.dot(axis_u), d.dot(axis_v), d.dot(view)]
+        })
+        .collect();
+    let (min_u, max_u) = extent(proj.iter().map(|q| q[0]));
+    let (min_v, max_v) = extent(proj.iter().map(|q| q[1]));
+    let (size_u, size_v) = (max_u - min_u, max_v - min_v);
+    let thin = 1e-9 * scale.sqrt();
+    if !(size_u > thin && size_v > thin) {
+        return Err(FitError::DegenerateProjection {
+            reason: format!(
+                "the points project onto a segment ({size_u:.3e} × {size_v:.3e}) along view \
+                 {view}: they are collinear or seen edge-on"
+            ),
+        });
+    }
+    let uv: Vec<[f64; 2]> = proj
+        .iter()
+        .map(|q| [(q[0] - min_u) / size_u, (q[1] - min_v) / size_v])
+        .collect();
+    let depth: Vec<f64> = proj.iter().map(|q| q[2]).collect();
+    let folded = detect_folds(&uv, &depth, size_u, size_v, opts.fold_gap_cells);
+    let frame = ProjectionFrame {
+        origin: center + axis_u * min_u + axis_v * min_v,
+        axis_u,
+        axis_v,
+        view,
+        size_u,
+        size_v,
+    };
+    finish(uv, folded, Some(frame), opts.fold_policy)
+}
+
+/// Parameters from the closest points on a user base surface S_B, seeded from a grid of
+/// samples; folds are detected on (u, v, signed distance along the normal).
+pub fn parameterize_on_surface(
+    points: &[Point3],
+    base: &BSplineSurface,
+    opts: &ParamOptions,
+) -> Result<Parameterization, FitError> {
+    check_points(points, 3)?;
+    let ((u0, u1), (v0, v1)) = base.domain();
+    const SAMPLES: usize = 33;
+    let seeds: Vec<(f64, f64, Point3)> = (0..SAMPLES * SAMPLES)
+        .map(|k| {
+            let u = u0 + (u1 - u0) * (k / SAMPLES) as f64 / (SAMPLES - 1) as f64;
+            let v = v0 + (v1 - v0) * (k % SAMPLES) as f64 / (SAMPLES - 1) as f64;
+            (u, v, base.eval(u, v))
+        })
+        .collect();
+    // Physical size of the parameter rectangle (mid-line lengths), for the fold cell size.
+    let mid = SAMPLES / 2;
+    let at = |a: usize, b: usize| seeds[a * SAMPLES + b].2;
+    let size_u: f64 = (1..SAMPLES)
+        .map(|a| (at(a, mid) - at(a - 1, mid)).length())
+        .sum();
+    let size_v: f64 = (1..SAMPLES)
+        .map(|b| (at(mid, b) - at(mid, b - 1)).length())
+        .sum();
+    let mut uv = Vec::with_capacity(points.len());
+    let mut depth = Vec::with_capacity(points.len());
+    for p in points {
+        let seed = seeds
+            .iter()
+            .min_by(|a, b| {
+                (a.2 - *p)
+                    .length_squared()
+                    .total_cmp(&(b.2 - *p).length_squared())
+            })
+            .map_or((u0, v0), |s| (s.0, s.1));
+        let near = base.closest_point(*p, seed.0, seed.1, NewtonOptions::default());
+        let d = base.derivs(near.u, near.v, 1);
+        let normal = d.skl[1][0].cross(d.skl[0][1]).normalize_or_zero();
+        uv.push([(near.u - u0) / (u1 - u0), (near.v - v0) / (v1 - v0)]);
+        depth.push((*p - near.point).dot(normal));
+    }
+    let folded = detect_folds(
+        &uv,
+        &depth,
+        size_u.max(f64::MIN_POSITIVE),
+        size_v.max(f64::MIN_POSITIVE),
+        opts.fold_gap_cells,
+    );
+    let uv = uv
+        .into_iter()
+        .map(|[u, v]| [u0 + u * (u1 - u0), v0 + v * (v1 - v0)])
+        .collect();
+    finish(uv, folded, None, opts.fold_policy)
+}
+
+fn finish(
+    uv: Vec<[f64; 2]>,
+    folded: Vec<bool>,
+    frame: Option<ProjectionFrame>,
+    policy: FoldPolicy,
+) -> Result<Parameterization, FitError> {
+    let num_folded = folded.iter().filter(|&&f| f).count();
+    if policy == FoldPolicy::Fail && num_folded > 0 {
+        let first = folded.iter().position(|&f| f).unwrap_or(0);
+        return Err(FitError::FoldedProjection {
+            count: num_folded,
+            total: uv.len(),
+            first,
+        });
+    }
+    Ok(Parameterization {
+        uv,
+        folded,
+        num_folded,
+        frame,
+    })
+}
+
+/// Marks points that are not on the main layer of their projection cell. Cells are about twice
+/// the mean projected point spacing; within a cell the depths are sorted and split into layers
+/// wherever consecutive depths jump by more than `gap_cells` cell sizes (a single sheet, even a
+/// steep one, has depth steps no larger than its sampling). The largest layer is the main one
+/// (ties: the nearest to the viewer).
+fn detect_folds(
+    uv: &[[f64; 2]],
+    depth: &[f64],
+    size_u: f64,
+    size_v: f64,
+    gap_cells: f64,
+) -> Vec<bool> {
+    let n = uv.len();
+    let cell = 2.0 * (size_u * size_v / n as f64).sqrt();
+    let gap = gap_cells * cell;
+    let cols = ((size_u / cell).ceil() as usize).clamp(1, 1 << 15);
+    let rows = ((size_v / cell).ceil() as usize).clamp(1, 1 << 15);
+    let mut cells: HashMap<usize, Vec<usize>> = HashMap::new();
+    for (i, [u, v]) in uv.iter().enumerate() {
+        let cu = ((u * cols as f64) as usize).min(cols - 1);
+        let cv = ((v * rows as f64) as usize).min(rows - 1);
+        cells.entry(cu * rows + cv).or_default().push(i);
+    }
+    let mut folded = vec![false; n];
+    let mut keys: Vec<usize> = cells.keys().copied().collect();
+    keys.sort_unstable();
+    for key in keys {
+        let Some(members) = cells.get_mut(&key) else {
+            continue;
+        };
+        members.sort_by(|&a, &b| depth[a].total_cmp(&depth[b]));
+        mark_minor_layers(members, depth, gap, &mut folded);
+    }
+    folded
+}
+
+/// Splits depth-sorted `members` into layers at gaps above `gap` and flags all but the largest.
+fn mark_minor_layers(members: &[usize], depth: &[f64], gap: f64, folded: &mut [bool]) {
+    let mut layers: Vec<(usize, usize)> = Vec::new();
+    let mut start = 0;
+    for k in 1..=members.len() {
+        if k == members.len() || depth[members[k]] - depth[members[k - 1]] > gap {
+            layers.push((start, k));
+            start = k;
+        }
+    }
+    if layers.len() < 2 {
+        return;
+    }
+    let main = layers
+        .iter()
+        .enumerate()
+        .max_by(|a, b| {
+            (a.1 .1 - a.1 .0)
+                .cmp(&(b.1 .1 - b.1 .0))
+                .then(b.0.cmp(&a.0))
+        })
+        .map_or(0, |(i, _)| i);
+    for (li, &(s, e)) in layers.iter().enumerate() {
+        if li != main {
+            for &m in &members[s..e] {
+                folded[m] = true;
+            }
+        }
+    }
+}
+
+/// The in-plane axes, rotated about the view, whose bounding rectangle of the projected points
+/// has the least area (1° steps over a quarter turn): the parameter rectangle then wastes as
+/// little of its domain on empty patches as the data's outline allows.
+fn min_area_axes(points: &[Point3], center: Point3, a: Vec3, b: Vec3) -> (Vec3, Vec3) {
+    let flat: Vec<(f64, f64)> = points
+        .iter()
+        .map(|p| ((*p - center).dot(a), (*p - center).dot(b)))
+        .collect();
+    let area = |deg: usize| {
+        let (s, c) = (deg as f64).to_radians().sin_cos();
+        let (lo_u, hi_u) = extent(flat.iter().map(|&(x, y)| c * x + s * y));
+        let (lo_v, hi_v) = extent(flat.iter().map(|&(x, y)| -s * x + c * y));
+        (hi_u - lo_u) * (hi_v - lo_v)
+    };
+    let best = (0..90)
+        .min_by(|&i, &j| area(i).total_cmp(&area(j)))
+        .unwrap_or(0);
+    let (s, c) = (best as f64).to_radians().sin_cos();
+    (a * c + b * s, b * c - a * s)
+}
+
+fn extent<I: Iterator<Item = f64>>(values: I) -> (f64, f64) {
+    values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
+        (lo.min(x), hi.max(x))
+    })
+}
+
+/// Eigenvalues (descending) and unit eigenvectors of the points' covariance matrix (cyclic
+/// Jacobi on the symmetric 3 × 3 matrix).
+fn principal_axes(points: &[Point3], center: Point3) -> ([f64; 3], [Vec3; 3]) {
+    let mut c = [[0.0; 3]; 3];
+    for p in points {
+        let d = (*p - center).to_array();
+        for (r, row) in c.iter_mut().enumerate() {
+            for (s, x) in row.iter_mut().enumerate() {
+                *x += d[r] * d[s];
+            }
+        }
+    }
+    let n = points.len() as f64;
+    for row in c.iter_mut() {
+        for x in row.iter_mut() {
+            *x /= n;
+        }
+    }
+    let (values, vectors) = jacobi_eigen(c);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| values[b].total_cmp(&values[a]));
+    let axis = |k: usize| Vec3::new(vectors[0][k], vectors[1][k], vectors[2][k]);
+    (
+        [values[order[0]], values[order[1]], values[order[2]]],
+        [axis(order[0]), axis(order[1]), axis(order[2])],
+    )
+}
+
+/// Cyclic Jacobi eigen-decomposition of a symmetric 3 × 3 matrix: (eigenvalues, eigenvectors as
+/// the columns of the second result).
+fn jacobi_eigen(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _sweep in 0..50 {
+        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
+        let diag = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
+        if off <= 1e-15 * diag || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let (cs, sn) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+            for k in 0..3 {
+                let (akp, akq) = (a[k][p], a[k][q]);
+                a[k][p] = cs * akp - sn * akq;
+                a[k][q] = sn * akp + cs * akq;
+            }
+            for k in 0..3 {
+                let (apk, aqk) = (a[p][k], a[q][k]);
+                a[p][k] = cs * apk - sn * aqk;
+                a[q][k] = sn * apk + cs * aqk;
+            }
+            for row in v.iter_mut() {
+                let (vp, vq) = (row[p], row[q]);
+                row[p] = cs * vp - sn * vq;
+                row[q] = sn * vp + cs * vq;
+            }
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2]], v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jacobi_diagonalises() {
+        let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 1.0]];
+        let (vals, vecs) = jacobi_eigen(m);
+        for k in 0..3 {
+            for r in 0..3 {
+                let mv: f64 = (0..3).map(|s| m[r][s] * vecs[s][k]).sum();
+                assert!((mv - vals[k] * vecs[r][k]).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn layers_split_at_gaps() {
+        let depth = [0.0, 0.1, 0.2, 5.0, 5.1];
+        let mut folded = vec![false; 5];
+        mark_minor_layers(&[0, 1, 2, 3, 4], &depth, 1.0, &mut folded);
+        assert_eq!(folded, vec![false, false, false, true, true]);
+    }
+}
