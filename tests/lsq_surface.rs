@@ -215,7 +215,7 @@ fn fold_over_is_detected() {
     let opts = LsqSurfaceOptions::default()
         .with_control(5, 5)
         .with_fixed_knots(true)
-        .with_param(view);
+        .with_param(view.with_fold_policy(FoldPolicy::Exclude));
     let mut fit = LsqSurfaceFitter::try_new(&pts, opts).unwrap();
     fit.run().unwrap();
     assert_eq!(fit.num_folded(), 450);

@@ -39,9 +39,10 @@ pub struct LsqSurfaceOptions {
     /// Keep the knots fixed (no patch splitting): the fit only re-solves with corrected
     /// parameters. Default false.
     pub fixed_knots: bool,
-    /// Thin-plate weight β2 (scaled per patch by 1/ρ). Default 1e-6.
+    /// Thin-plate weight β2 (scaled per patch by 1/ρ). Default 1e-12: enough to hold empty
+    /// patches, small against the data term where there are points.
     pub beta2: f64,
-    /// Curvature-variation weight β3 (scaled per patch by ρ). Default 1e-9.
+    /// Curvature-variation weight β3 (scaled per patch by ρ). Default 1e-15.
     pub beta3: f64,
     /// Tolerance TOL, % of the bounding-box diagonal. Default 0.1.
     pub tol_pct: f64,
@@ -55,7 +56,7 @@ pub struct LsqSurfaceOptions {
     pub solves_per_knots: usize,
     /// Iteration cap. Default 30.
     pub max_iterations: usize,
-    /// Newton iterations per point in parameter correction. Default 6.
+    /// Newton iterations per point in parameter correction (warm-started). Default 4.
     pub newton_iterations: usize,
     /// How the initial parameters are found.
     pub param: ParamOptions,
@@ -67,15 +68,15 @@ impl Default for LsqSurfaceOptions {
             degree: 3,
             control: (8, 8),
             fixed_knots: false,
-            beta2: 1e-6,
-            beta3: 1e-9,
+            beta2: 1e-12,
+            beta3: 1e-15,
             tol_pct: 0.1,
             tol_mode: TolMode::Noisy,
             max_control_points: 40_000,
             min_points_to_split: 16,
             solves_per_knots: 2,
             max_iterations: 30,
-            newton_iterations: 6,
+            newton_iterations: 4,
             param: ParamOptions::default(),
         }
     }

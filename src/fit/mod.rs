@@ -4,6 +4,7 @@
 //! per-point errors at any time.
 
 mod accel;
+pub mod bspline_surface;
 pub mod closest;
 pub mod curve;
 mod curve_lsq;
@@ -20,6 +21,7 @@ mod scheme;
 mod stats;
 pub mod subdiv;
 
+pub use bspline_surface::{GeometricSurfaceFitter, GeometricSurfaceOptions};
 pub use closest::FootPoint;
 pub use curve::{CurveFitOptions, CurveFitter};
 pub use curve_lsq::least_squares_curve;

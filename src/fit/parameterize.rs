@@ -19,10 +19,11 @@ use std::collections::HashMap;
 pub enum FoldPolicy {
     /// Fail with [`FitError::FoldedProjection`].
     Fail,
-    /// Leave folded points out of the fit (they are still measured). The default.
-    #[default]
+    /// Leave folded points out of the fit (they are still measured).
     Exclude,
-    /// Fit folded points like all others; they are only counted.
+    /// Fit folded points like all others (their parameters are corrected by closest points
+    /// during the fit); they are only counted. The default.
+    #[default]
     Keep,
 }
 
@@ -33,19 +34,23 @@ pub struct ParamOptions {
     /// View direction to project along; `None` (default) takes the least-variance principal
     /// axis of the points.
     pub view: Option<Vec3>,
-    /// What folded points do. Default [`FoldPolicy::Exclude`].
+    /// What folded points do. Default [`FoldPolicy::Keep`].
     pub fold_policy: FoldPolicy,
     /// Two points of one projection cell whose depths differ by more than this many cell
     /// sizes lie on different layers of a fold. Default 4.
     pub fold_gap_cells: f64,
+    /// Rotate the parameter rectangle about the view to the least-area bounding rectangle
+    /// of the projected points. Default true.
+    pub min_area: bool,
 }
 
 impl Default for ParamOptions {
     fn default() -> Self {
         ParamOptions {
             view: None,
-            fold_policy: FoldPolicy::Exclude,
+            fold_policy: FoldPolicy::Keep,
             fold_gap_cells: 4.0,
+            min_area: true,
         }
     }
 }
@@ -132,27 +137,74 @@ pub fn parameterize(points: &[Point3], opts: &ParamOptions) -> Result<Parameteri
     check_points(points, 3)?;
     let center = points.iter().copied().sum::<Point3>() / points.len() as f64;
     let (values, axes) = principal_axes(points, center);
-    let scale = values[0].max(f64::MIN_POSITIVE);
-    let view = match opts.view {
-        Some(v) => {
-            let len = v.length();
-            if !(len.is_finite() && len > 0.0) {
-                return Err(FitError::InvalidOption {
-                    name: "view",
-                    reason: format!("the view direction {v} must be finite and non-zero"),
-                });
-            }
-            v / len
+    let scale = values[0].max(f64::MIN_POSITIVE).sqrt();
+    if let Some(v) = opts.view {
+        let len = v.length();
+        if !(len.is_finite() && len > 0.0) {
+            return Err(FitError::InvalidOption {
+                name: "view",
+                reason: format!("the view direction {v} must be finite and non-zero"),
+            });
         }
-        None => axes[2],
+        let (param, _) = project_along(points, center, axes, v / len, scale, opts)?;
+        return finish(param, opts.fold_policy);
+    }
+    // No view given: the least-variance axis, or the direction tilted from it (15° and 30°,
+    // eight azimuths) under which the fewest points fold — a range scan's own view direction
+    // is rarely the least-variance axis of the shape it sees.
+    let quick = ParamOptions {
+        min_area: false,
+        ..*opts
     };
+    let mut best: Option<(Vec3, usize)> = None;
+    for view in candidate_views(axes) {
+        let Ok((_, folds)) = project_along(points, center, axes, view, scale, &quick) else {
+            continue;
+        };
+        if best.is_none_or(|b| folds < b.1) {
+            best = Some((view, folds));
+        }
+    }
+    let view = best.map_or(axes[2], |b| b.0);
+    let (param, _) = project_along(points, center, axes, view, scale, opts)?;
+    finish(param, opts.fold_policy)
+}
+
+/// The least-variance axis first, then tilts of 15° and 30° towards eight azimuths.
+fn candidate_views(axes: [Vec3; 3]) -> Vec<Vec3> {
+    let mut views = vec![axes[2]];
+    for tilt in [15.0f64, 30.0] {
+        for k in 0..8 {
+            let az = (k as f64 * 45.0).to_radians();
+            let side = axes[0] * az.cos() + axes[1] * az.sin();
+            let t = tilt.to_radians();
+            views.push((axes[2] * t.cos() + side * t.sin()).normalize());
+        }
+    }
+    views
+}
+
+/// Projects along the unit `view` onto the plane through `center`, in the least-area
+/// rectangle, and counts the folded points.
+fn project_along(
+    points: &[Point3],
+    center: Point3,
+    axes: [Vec3; 3],
+    view: Vec3,
+    scale: f64,
+    opts: &ParamOptions,
+) -> Result<(Parameterization, usize), FitError> {
     // In-plane axes: the principal axes with the view component removed.
     let axis_u = (axes[0] - view * axes[0].dot(view)).try_normalize();
     let axis_u = axis_u
         .or_else(|| (axes[1] - view * axes[1].dot(view)).try_normalize())
         .unwrap_or(Vec3::X);
     let axis_v = view.cross(axis_u).normalize_or_zero();
-    let (axis_u, axis_v) = min_area_axes(points, center, axis_u, axis_v);
+    let (axis_u, axis_v) = if opts.min_area {
+        min_area_axes(points, center, axis_u, axis_v)
+    } else {
+        (axis_u, axis_v)
+    };
     let proj: Vec<[f64; 3]> = points
         .iter()
         .map(|p| {
@@ -163,7 +215,7 @@ pub fn parameterize(points: &[Point3], opts: &ParamOptions) -> Result<Parameteri
     let (min_u, max_u) = extent(proj.iter().map(|q| q[0]));
     let (min_v, max_v) = extent(proj.iter().map(|q| q[1]));
     let (size_u, size_v) = (max_u - min_u, max_v - min_v);
-    let thin = 1e-9 * scale.sqrt();
+    let thin = 1e-9 * scale;
     if !(size_u > thin && size_v > thin) {
         return Err(FitError::DegenerateProjection {
             reason: format!(
@@ -178,6 +230,7 @@ pub fn parameterize(points: &[Point3], opts: &ParamOptions) -> Result<Parameteri
         .collect();
     let depth: Vec<f64> = proj.iter().map(|q| q[2]).collect();
     let folded = detect_folds(&uv, &depth, size_u, size_v, opts.fold_gap_cells);
+    let num_folded = folded.iter().filter(|&&f| f).count();
     let frame = ProjectionFrame {
         origin: center + axis_u * min_u + axis_v * min_v,
         axis_u,
@@ -186,7 +239,13 @@ pub fn parameterize(points: &[Point3], opts: &ParamOptions) -> Result<Parameteri
         size_u,
         size_v,
     };
-    finish(uv, folded, Some(frame), opts.fold_policy)
+    let param = Parameterization {
+        uv,
+        folded,
+        num_folded,
+        frame: Some(frame),
+    };
+    Ok((param, num_folded))
 }
 
 /// Parameters from the closest points on a user base surface S_B, seeded from a grid of
@@ -243,30 +302,26 @@ pub fn parameterize_on_surface(
         .into_iter()
         .map(|[u, v]| [u0 + u * (u1 - u0), v0 + v * (v1 - v0)])
         .collect();
-    finish(uv, folded, None, opts.fold_policy)
-}
-
-fn finish(
-    uv: Vec<[f64; 2]>,
-    folded: Vec<bool>,
-    frame: Option<ProjectionFrame>,
-    policy: FoldPolicy,
-) -> Result<Parameterization, FitError> {
     let num_folded = folded.iter().filter(|&&f| f).count();
-    if policy == FoldPolicy::Fail && num_folded > 0 {
-        let first = folded.iter().position(|&f| f).unwrap_or(0);
-        return Err(FitError::FoldedProjection {
-            count: num_folded,
-            total: uv.len(),
-            first,
-        });
-    }
-    Ok(Parameterization {
+    let param = Parameterization {
         uv,
         folded,
         num_folded,
-        frame,
-    })
+        frame: None,
+    };
+    finish(param, opts.fold_policy)
+}
+
+fn finish(param: Parameterization, policy: FoldPolicy) -> Result<Parameterization, FitError> {
+    if policy == FoldPolicy::Fail && param.num_folded > 0 {
+        let first = param.folded.iter().position(|&f| f).unwrap_or(0);
+        return Err(FitError::FoldedProjection {
+            count: param.num_folded,
+            total: param.uv.len(),
+            first,
+        });
+    }
+    Ok(param)
 }
 
 /// Marks points that are not on the main layer of their projection cell. Cells are about twice
@@ -350,9 +405,15 @@ fn min_area_axes(points: &[Point3], center: Point3, a: Vec3, b: Vec3) -> (Vec3, 
         let (lo_v, hi_v) = extent(flat.iter().map(|&(x, y)| -s * x + c * y));
         (hi_u - lo_u) * (hi_v - lo_v)
     };
-    let best = (0..90)
+    // Every 6°, then every 1° around the best.
+    let coarse = (0..15)
+        .map(|k| k * 6)
         .min_by(|&i, &j| area(i).total_cmp(&area(j)))
         .unwrap_or(0);
+    let best = (coarse + 90 - 5..=coarse + 90 + 5)
+        .map(|d| d % 90)
+        .min_by(|&i, &j| area(i).total_cmp(&area(j)))
+        .unwrap_or(coarse);
     let (s, c) = (best as f64).to_radians().sin_cos();
     (a * c + b * s, b * c - a * s)
 }

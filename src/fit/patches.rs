@@ -187,6 +187,7 @@ pub(crate) fn split_worst(
 
 /// Parameter correction: moves each point's (u, v) to its foot point on `surface` by Newton
 /// from the current value and stores the signed distance (positive on the side of S_u × S_v).
+/// Newton stops at a parameter step of 1e-9 of the domain: far below any fitting tolerance.
 pub(crate) fn correct_parameters(
     surface: &BSplineSurface,
     points: &[Point3],
@@ -194,30 +195,15 @@ pub(crate) fn correct_parameters(
     dist: &mut [f64],
     iterations: usize,
 ) {
-    let opts = NewtonOptions::default().with_max_iterations(iterations);
+    let opts = NewtonOptions::default()
+        .with_max_iterations(iterations)
+        .with_param_tolerance(1e-9);
     for ((p, t), d) in points.iter().zip(uv.iter_mut()).zip(dist.iter_mut()) {
         let near = surface.closest_point(*p, t[0], t[1], opts);
         *t = [near.u, near.v];
-        *d = signed_distance(surface, *p, near.u, near.v, near.point);
-    }
-}
-
-/// Distance from `p` to the surface point at (u, v), signed by the normal S_u × S_v.
-pub(crate) fn signed_distance(
-    surface: &BSplineSurface,
-    p: Point3,
-    u: f64,
-    v: f64,
-    foot: Point3,
-) -> f64 {
-    let d = surface.derivs(u, v, 1);
-    let normal = d.skl[1][0].cross(d.skl[0][1]);
-    let e = p - foot;
-    let len = e.length();
-    if e.dot(normal) < 0.0 {
-        -len
-    } else {
-        len
+        let e = *p - near.point;
+        let len = e.length();
+        *d = if e.dot(near.normal) < 0.0 { -len } else { len };
     }
 }
 

@@ -67,6 +67,12 @@ impl NewtonOptions {
         self.max_iterations = n;
         self
     }
+
+    /// Sets the convergence threshold on the parameter step (fraction of the domain size).
+    pub fn with_param_tolerance(mut self, tol: f64) -> Self {
+        self.param_tolerance = tol;
+        self
+    }
 }
 
 /// A foot point found by [`BSplineSurface::closest_point`].
@@ -80,6 +86,8 @@ pub struct SurfaceNearest {
     pub point: Point3,
     /// Squared distance from the query point to `point`.
     pub dist_sq: f64,
+    /// Unit normal S_u × S_v at the foot point (zero where the surface is degenerate).
+    pub normal: Vec3,
     /// Newton iterations used.
     pub iterations: usize,
     /// Whether the step fell under the tolerance (at an interior minimum or on the boundary).
@@ -231,9 +239,16 @@ impl BSplineSurface {
             for (s, t) in temp.iter_mut().enumerate().take(q + 1) {
                 for r in 0..=p {
                     let idx = (fu + r) * nv + fv + s;
-                    let wt = self.weight(idx);
-                    t.0 += bu[k][r] * wt * self.control[idx];
-                    t.1 += bu[k][r] * wt;
+                    match &self.weights {
+                        None => {
+                            t.0 += bu[k][r] * self.control[idx];
+                            t.1 += bu[k][r];
+                        }
+                        Some(w) => {
+                            t.0 += bu[k][r] * w[idx] * self.control[idx];
+                            t.1 += bu[k][r] * w[idx];
+                        }
+                    }
                 }
             }
             for l in 0..=(d - k) {
@@ -376,11 +391,15 @@ impl BSplineSurface {
         }
         let point = current.point();
         let dist_sq = if p.is_finite() { dist_sq } else { f64::MAX };
+        let normal = current.skl[1][0]
+            .cross(current.skl[0][1])
+            .normalize_or_zero();
         SurfaceNearest {
             u,
             v,
             point,
             dist_sq,
+            normal,
             iterations,
             converged,
         }

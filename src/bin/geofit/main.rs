@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 mod export_samples;
 mod fit;
+mod fit_bspline;
 mod fit_curve;
 mod info;
 mod reconstruct;
@@ -32,6 +33,8 @@ enum Command {
     /// Write reference curves and surfaces as IGES and STEP with sampled points (for
     /// interoperability tests).
     ExportSamples(export_samples::Args),
+    /// Fit one tensor-product B-spline surface to a scan (least squares or geometric).
+    FitBspline(fit_bspline::Args),
     /// Simplify a mesh by quadric error metrics to a target vertex count (the initial control
     /// mesh of a fit), timed, with its distance to the input.
     Simplify(simplify::Args),
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(args),
         Command::FitCurve(args) => fit_curve::run(args),
         Command::ExportSamples(args) => export_samples::run(args),
+        Command::FitBspline(args) => fit_bspline::run(args),
         Command::Simplify(args) => simplify::run(args),
         Command::Reconstruct(args) => reconstruct::run(args),
         Command::Subdiv(args) => subdiv::run(args),

@@ -1,0 +1,349 @@
+//! Geometric fitting of a tensor-product B-spline surface (SPEC §1, applied to B-splines):
+//! no linear system. Each iteration finds the foot points by Newton, distributes every error
+//! vector e_s = Q_s − S(u_s, v_s) to the (p + 1)(q + 1) control points of its patch weighted
+//! by the basis values there, normalises per control point (d = Σ N e / Σ N), and moves the
+//! control points, with Anderson acceleration and a damping guard that falls back to the plain
+//! step when the error grows. Where the error stays above the tolerance, knots are inserted in
+//! the worst patches (the surface is unchanged by insertion, so the fit continues from where it
+//! was).
+
+use super::accel::Accelerator;
+use super::lsq_surface::{check_common, plane_surface};
+use super::options::Acceleration;
+use super::parameterize::{check_points, parameterize, ParamOptions};
+use super::patches::{correct_parameters, patch_errors, split_worst, PatchGrid, TolMode};
+use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
+use crate::geom::{Aabb, Point3, Vec3};
+use crate::spline::BSplineSurface;
+use web_time::Instant;
+
+/// Options of [`GeometricSurfaceFitter`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct GeometricSurfaceOptions {
+    /// Degree in u and v. Default 3.
+    pub degree: usize,
+    /// Initial control points (u, v). Default (8, 8).
+    pub control: (usize, usize),
+    /// Keep the knots fixed. Default false.
+    pub fixed_knots: bool,
+    /// Tolerance TOL, % of the bounding-box diagonal. Default 0.1.
+    pub tol_pct: f64,
+    /// How patches are judged against TOL. Default [`TolMode::Noisy`].
+    pub tol_mode: TolMode,
+    /// Acceleration of the control-point moves. Default Anderson with depth 5.
+    pub acceleration: Acceleration,
+    /// Iterations on one knot vector before refining, unless the error stalls earlier
+    /// (relative E_rms gain under 1 %). Default 12.
+    pub iterations_per_knots: usize,
+    /// Cap on the control-point count. Default 40,000.
+    pub max_control_points: usize,
+    /// A patch with fewer points than this is not split further. Default 16.
+    pub min_points_to_split: usize,
+    /// Iteration cap. Default 200.
+    pub max_iterations: usize,
+    /// Newton iterations per point and iteration (warm-started). Default 3.
+    pub newton_iterations: usize,
+    /// How the initial parameters are found.
+    pub param: ParamOptions,
+}
+
+impl Default for GeometricSurfaceOptions {
+    fn default() -> Self {
+        GeometricSurfaceOptions {
+            degree: 3,
+            control: (8, 8),
+            fixed_knots: false,
+            tol_pct: 0.1,
+            tol_mode: TolMode::Noisy,
+            acceleration: Acceleration::Anderson { depth: 5 },
+            iterations_per_knots: 12,
+            max_control_points: 40_000,
+            min_points_to_split: 16,
+            max_iterations: 200,
+            newton_iterations: 3,
+            param: ParamOptions::default(),
+        }
+    }
+}
+
+impl GeometricSurfaceOptions {
+    /// Sets the degree.
+    pub fn with_degree(mut self, degree: usize) -> Self {
+        self.degree = degree;
+        self
+    }
+    /// Sets the initial control-point counts.
+    pub fn with_control(mut self, nu: usize, nv: usize) -> Self {
+        self.control = (nu, nv);
+        self
+    }
+    /// Keeps the knots fixed.
+    pub fn with_fixed_knots(mut self, fixed: bool) -> Self {
+        self.fixed_knots = fixed;
+        self
+    }
+    /// Sets the tolerance (%) and its mode.
+    pub fn with_tolerance(mut self, tol_pct: f64, mode: TolMode) -> Self {
+        self.tol_pct = tol_pct;
+        self.tol_mode = mode;
+        self
+    }
+    /// Sets the acceleration.
+    pub fn with_acceleration(mut self, acceleration: Acceleration) -> Self {
+        self.acceleration = acceleration;
+        self
+    }
+    /// Sets the iteration cap.
+    pub fn with_max_iterations(mut self, n: usize) -> Self {
+        self.max_iterations = n;
+        self
+    }
+    /// Sets the cap on control points.
+    pub fn with_max_control_points(mut self, n: usize) -> Self {
+        self.max_control_points = n;
+        self
+    }
+    /// Sets the parameterisation options.
+    pub fn with_param(mut self, param: ParamOptions) -> Self {
+        self.param = param;
+        self
+    }
+}
+
+/// Geometric (error-vector) B-spline surface fitter, driven through [`Fitter`].
+pub struct GeometricSurfaceFitter {
+    points: Vec<Point3>,
+    active: Vec<bool>,
+    uv: Vec<[f64; 2]>,
+    dist: Vec<f64>,
+    num_folded: usize,
+    surface: BSplineSurface,
+    opts: GeometricSurfaceOptions,
+    diagonal: f64,
+    history: Vec<IterationRecord>,
+    accel: Accelerator,
+    iters_at_knots: usize,
+    initial_control: usize,
+    precompute_s: f64,
+    status: FitStatus,
+}
+
+impl GeometricSurfaceFitter {
+    /// Sets up a fit: checks points and options, parameterises the points by projection and
+    /// starts from the flat control net over the projection plane.
+    pub fn try_new(points: &[Point3], opts: GeometricSurfaceOptions) -> Result<Self, FitError> {
+        let start = Instant::now();
+        check_common(opts.degree, opts.control, opts.tol_pct)?;
+        if let Acceleration::Anderson { depth } = opts.acceleration {
+            if !(1..=20).contains(&depth) {
+                return Err(FitError::InvalidOption {
+                    name: "anderson depth",
+                    reason: format!("{depth} is outside 1..=20"),
+                });
+            }
+        }
+        check_points(points, opts.degree + 1)?;
+        let param = parameterize(points, &opts.param)?;
+        let surface = plane_surface(&param, opts.degree, opts.control)?;
+        let active: Vec<bool> = (0..points.len())
+            .map(|i| param.is_active(i, opts.param.fold_policy))
+            .collect();
+        let diagonal = Aabb::from_points(points).map_or(0.0, |b| b.diagonal());
+        let mut fitter = GeometricSurfaceFitter {
+            points: points.to_vec(),
+            active,
+            dist: vec![0.0; points.len()],
+            num_folded: param.num_folded,
+            uv: param.uv,
+            initial_control: opts.control.0 * opts.control.1,
+            surface,
+            opts,
+            diagonal,
+            history: Vec::new(),
+            accel: Accelerator::new(opts.acceleration),
+            iters_at_knots: 0,
+            precompute_s: 0.0,
+            status: FitStatus::Running,
+        };
+        fitter.foot_points();
+        fitter.precompute_s = start.elapsed().as_secs_f64();
+        Ok(fitter)
+    }
+
+    /// The current surface.
+    pub fn surface(&self) -> &BSplineSurface {
+        &self.surface
+    }
+
+    /// Points found on a fold-over of the initial projection.
+    pub fn num_folded(&self) -> usize {
+        self.num_folded
+    }
+
+    /// Control points at the start.
+    pub fn initial_control_points(&self) -> usize {
+        self.initial_control
+    }
+
+    /// Seconds spent in set-up (checks, parameterisation, first foot points).
+    pub fn precompute_seconds(&self) -> f64 {
+        self.precompute_s
+    }
+
+    /// The status after the last step.
+    pub fn status(&self) -> FitStatus {
+        self.status
+    }
+
+    fn foot_points(&mut self) {
+        correct_parameters(
+            &self.surface,
+            &self.points,
+            &mut self.uv,
+            &mut self.dist,
+            self.opts.newton_iterations,
+        );
+    }
+
+    /// The normalised basis-weighted error vector of every control point (zero where no
+    /// point's patch reaches it).
+    fn moves(&self) -> Vec<Vec3> {
+        let (nu, nv) = self.surface.num_control();
+        let (p, q) = (
+            self.surface.knots_u().degree(),
+            self.surface.knots_v().degree(),
+        );
+        let mut num = vec![Vec3::ZERO; nu * nv];
+        let mut den = vec![0.0; nu * nv];
+        for ((pt, t), _) in self
+            .points
+            .iter()
+            .zip(&self.uv)
+            .zip(&self.active)
+            .filter(|x| *x.1)
+        {
+            let b = self.surface.basis(t[0], t[1]);
+            let foot = self.surface.eval(t[0], t[1]);
+            let e = *pt - foot;
+            for r in 0..=p {
+                for s in 0..=q {
+                    let c = (b.first_u + r) * nv + b.first_v + s;
+                    let w = b.bu[r] * b.bv[s];
+                    num[c] += e * w;
+                    den[c] += w;
+                }
+            }
+        }
+        num.iter()
+            .zip(&den)
+            .map(|(n, &d)| if d > 1e-12 { *n / d } else { Vec3::ZERO })
+            .collect()
+    }
+
+    /// Moves the control points (accelerated), keeping the plain step when the accelerated one
+    /// raises the RMS error.
+    fn move_control_points(&mut self) -> Result<(), FitError> {
+        let rms_before = self.stats().e_rms;
+        let x = self.surface.control_points().to_vec();
+        let d = self.moves();
+        let proposed = self.accel.propose(&x, &d);
+        let set = |s: &mut BSplineSurface, pts: &[Point3]| {
+            s.set_control_points(pts).map_err(FitError::Spline)
+        };
+        set(&mut self.surface, &proposed)?;
+        let (uv_saved, dist_saved) = (self.uv.clone(), self.dist.clone());
+        self.foot_points();
+        if self.stats().e_rms > rms_before && proposed != plain_step(&x, &d) {
+            // Damping: the accelerated step overshot; take the plain one and forget history.
+            self.accel.reset();
+            set(&mut self.surface, &plain_step(&x, &d))?;
+            self.uv = uv_saved;
+            self.dist = dist_saved;
+            self.foot_points();
+        }
+        Ok(())
+    }
+}
+
+fn plain_step(x: &[Point3], d: &[Vec3]) -> Vec<Point3> {
+    x.iter().zip(d).map(|(a, b)| *a + *b).collect()
+}
+
+impl Fitter for GeometricSurfaceFitter {
+    fn step(&mut self) -> Result<FitStatus, FitError> {
+        if self.status != FitStatus::Running {
+            return Ok(self.status);
+        }
+        let start = Instant::now();
+        let rms_before = self.stats().e_rms;
+        self.move_control_points()?;
+        self.iters_at_knots += 1;
+        let grid = PatchGrid::of(&self.surface);
+        let tol = self.opts.tol_pct / 100.0 * self.diagonal;
+        let errors = patch_errors(
+            &self.surface,
+            &grid,
+            &self.uv,
+            &self.dist,
+            &self.active,
+            tol,
+            self.opts.tol_mode,
+        );
+        let stalled = self.stats().e_rms > 0.99 * rms_before;
+        let mut refined = false;
+        self.status = if errors.iter().all(|e| e.pass) {
+            FitStatus::Converged
+        } else if self.history.len() + 1 >= self.opts.max_iterations {
+            FitStatus::MaxIterations
+        } else if !(stalled || self.iters_at_knots >= self.opts.iterations_per_knots) {
+            FitStatus::Running
+        } else if self.opts.fixed_knots {
+            if stalled {
+                FitStatus::MaxIterations
+            } else {
+                FitStatus::Running
+            }
+        } else {
+            let inserted = split_worst(
+                &mut self.surface,
+                &grid,
+                &errors,
+                self.opts.max_control_points,
+                self.opts.min_points_to_split,
+            );
+            refined = inserted > 0;
+            self.iters_at_knots = 0;
+            self.accel.reset();
+            if refined || !stalled {
+                FitStatus::Running
+            } else {
+                FitStatus::MaxIterations
+            }
+        };
+        let stats = self.stats();
+        let (nu, nv) = self.surface.num_control();
+        self.history.push(IterationRecord {
+            iter: self.history.len() + 1,
+            control_points: nu * nv,
+            e_avg_pct: stats.e_avg_pct,
+            e_max_pct: stats.e_max_pct,
+            e_rms_pct: stats.e_rms_pct,
+            ms: start.elapsed().as_secs_f64() * 1e3,
+            refined,
+        });
+        Ok(self.status)
+    }
+
+    fn history(&self) -> &[IterationRecord] {
+        &self.history
+    }
+
+    fn point_errors(&self) -> &[f64] {
+        &self.dist
+    }
+
+    fn stats(&self) -> ErrorStats {
+        ErrorStats::from_distances(&self.dist, self.diagonal)
+    }
+}
