@@ -125,10 +125,9 @@ fn bad_input_is_rejected() {
     let mut c = control();
     assert!(matches!(
         BSplineSurface::try_new(knots_u(), knots_v(), c[..29].to_vec()),
-        Err(SplineError::ControlCountMismatch {
+        Err(SplineError::ControlPointCount {
             found: 29,
             expected: 30,
-            ..
         })
     ));
     c[4].y = f64::NAN;

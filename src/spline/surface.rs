@@ -360,23 +360,31 @@ impl BSplineSurface {
         let mut dist_sq = (current.point() - p).length_squared();
         while iterations < opts.max_iterations {
             iterations += 1;
-            let Some((su, sv)) = newton_step(&current, p) else {
+            let steps = newton_steps(&current, p);
+            if steps.iter().all(Option::is_none) {
                 converged = true;
                 break;
-            };
-            // Backtracking: halve the step until the distance does not grow.
-            let mut t = 1.0;
+            }
+            // Backtracking on the Newton step, then on the Gauss–Newton step: halve until the
+            // distance does not grow (a few ulps of slack: near the minimum rounding hides the
+            // true decrease).
             let mut accepted = None;
-            for _ in 0..12 {
-                let nu = self.knots_u.clamp(u + t * su);
-                let nv = self.knots_v.clamp(v + t * sv);
-                let d = self.derivs(nu, nv, 2);
-                let dsq = (d.point() - p).length_squared();
-                if dsq <= dist_sq {
-                    accepted = Some((nu, nv, d, dsq));
-                    break;
+            'search: for (su, sv) in steps.into_iter().flatten() {
+                // A tiny full step is taken as it is: there the distance no longer resolves
+                // the decrease, and Newton converges quadratically.
+                let tiny = su.abs().max(sv.abs()) <= 1e-6 * scale;
+                let mut t = 1.0;
+                for _ in 0..12 {
+                    let nu = self.knots_u.clamp(u + t * su);
+                    let nv = self.knots_v.clamp(v + t * sv);
+                    let d = self.derivs(nu, nv, 2);
+                    let dsq = (d.point() - p).length_squared();
+                    if dsq <= dist_sq * (1.0 + 8.0 * f64::EPSILON) || (tiny && t == 1.0) {
+                        accepted = Some((nu, nv, d, dsq));
+                        break 'search;
+                    }
+                    t *= 0.5;
                 }
-                t *= 0.5;
             }
             let Some((nu, nv, d, dsq)) = accepted else {
                 converged = true;
@@ -406,17 +414,14 @@ impl BSplineSurface {
     }
 }
 
-/// One Newton step (Δu, Δv) for min ½|S − p|², or `None` at a stationary point or when no
-/// descent step can be formed.
-fn newton_step(d: &SurfaceDerivs, p: Point3) -> Option<(f64, f64)> {
+/// Candidate steps (Δu, Δv) for min ½|S − p|²: the Newton step where the Hessian is positive
+/// definite, then the Gauss–Newton step; empty at a stationary point or when neither exists.
+fn newton_steps(d: &SurfaceDerivs, p: Point3) -> [Option<(f64, f64)>; 2] {
     let r = d.skl[0][0] - p;
     let (su, sv) = (d.skl[1][0], d.skl[0][1]);
     let g = [su.dot(r), sv.dot(r)];
-    if !(g[0].is_finite() && g[1].is_finite()) {
-        return None;
-    }
-    if g[0] == 0.0 && g[1] == 0.0 {
-        return None;
+    if !(g[0].is_finite() && g[1].is_finite()) || (g[0] == 0.0 && g[1] == 0.0) {
+        return [None, None];
     }
     let gn = [su.dot(su), su.dot(sv), sv.dot(sv)];
     let full = [
@@ -424,7 +429,7 @@ fn newton_step(d: &SurfaceDerivs, p: Point3) -> Option<(f64, f64)> {
         gn[1] + d.skl[1][1].dot(r),
         gn[2] + d.skl[0][2].dot(r),
     ];
-    solve_2x2(full, g).or_else(|| solve_2x2(gn, g))
+    [solve_2x2(full, g), solve_2x2(gn, g)]
 }
 
 /// Solves the symmetric positive-definite system [[h0, h1], [h1, h2]] x = −g.
