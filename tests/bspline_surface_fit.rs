@@ -110,3 +110,79 @@ fn bad_options_are_typed_errors() {
         Err(FitError::TooFewPoints { .. })
     ));
 }
+
+#[test]
+fn cli_fit_scheme_bspline_writes_the_report() {
+    let dir = std::env::temp_dir().join(format!("geofit_bspline_cli_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let data = dir.join("wave.xyz");
+    let text: String = wave(30)
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(&data, text).unwrap();
+    let report = dir.join("r.json");
+    let step = dir.join("s.stp");
+    for method in ["least-squares", "geometric"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
+            .args([
+                "fit",
+                data.to_str().unwrap(),
+                "--scheme",
+                "bspline",
+                "--ctrl-u",
+                "6",
+            ])
+            .args([
+                "--ctrl-v",
+                "7",
+                "--method",
+                method,
+                "--json",
+                report.to_str().unwrap(),
+            ])
+            .args(["--step", step.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let r: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        assert_eq!(r["scheme"], "bspline");
+        assert_eq!(r["points"], 900);
+        assert_eq!(r["control_points_u"], 6);
+        assert_eq!(r["control_points_v"], 7);
+        assert_eq!(r["final_control_points"], 42);
+        for key in [
+            "e_avg_pct",
+            "e_max_pct",
+            "e_rms_pct",
+            "precompute_s",
+            "fit_s",
+            "total_s",
+        ] {
+            assert!(r[key].as_f64().is_some_and(f64::is_finite), "{key}");
+        }
+        assert!(!r["history"].as_array().unwrap().is_empty());
+        assert!(std::fs::read_to_string(&step)
+            .unwrap()
+            .contains("B_SPLINE_SURFACE_WITH_KNOTS"));
+    }
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
+        .args([
+            "fit",
+            data.to_str().unwrap(),
+            "--scheme",
+            "bspline",
+            "--ctrl",
+            "50",
+        ])
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("not a square"));
+    std::fs::remove_dir_all(&dir).ok();
+}

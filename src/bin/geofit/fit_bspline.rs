@@ -1,8 +1,9 @@
 //! `geofit fit-bspline FILE [--degree 3] [--method geometric|least-squares] [--beta2 X]
 //! [--beta3 X] [--tol-max PCT] [--tol-mode exact|noisy] [--ctrl N | --ctrl-u N --ctrl-v N]
-//! [--json R.json] [--surface-json S.json]`: fit one tensor-product B-spline surface to a scan
-//! (the `--scheme bspline` branch of `geofit fit`).
+//! [--json R.json] [--surface-json S.json] [--iges OUT.igs] [--step OUT.stp]`: fit one tensor-product B-spline surface to a scan
+//! (the `--scheme bspline` branch of `geofit fit`, routed here by [`route`]).
 
+use geofit::export::{iges::write_iges, step::write_step, ExportModel, SurfaceDesc};
 use geofit::fit::{
     FitReport, FitStatus, Fitter, FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions,
     LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, TolMode,
@@ -98,6 +99,45 @@ pub struct Args {
     /// Write the fitted surface (degree, knots, control grid) as JSON to this file.
     #[arg(long)]
     surface_json: Option<PathBuf>,
+    /// Export the fitted surface as IGES (entity 128).
+    #[arg(long)]
+    iges: Option<PathBuf>,
+    /// Export the fitted surface as STEP (AP214 B_SPLINE_SURFACE_WITH_KNOTS).
+    #[arg(long)]
+    step: Option<PathBuf>,
+}
+
+/// Lets `geofit fit FILE --scheme bspline ...` reach this command: rewrites the arguments to
+/// `geofit fit-bspline FILE ...` when the `fit` subcommand asks for the bspline scheme.
+pub fn route(args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
+    let is = |a: &std::ffi::OsString, s: &str| a.to_str() == Some(s);
+    if args.len() < 2 || !is(&args[1], "fit") {
+        return args;
+    }
+    let pos = args.iter().position(|a| is(a, "--scheme"));
+    let bspline = match pos {
+        Some(i) => args.get(i + 1).is_some_and(|a| is(a, "bspline")),
+        None => args.iter().any(|a| is(a, "--scheme=bspline")),
+    };
+    if !bspline {
+        return args;
+    }
+    let mut out = vec![args[0].clone(), "fit-bspline".into()];
+    let mut skip = false;
+    for (i, a) in args.iter().enumerate().skip(2) {
+        if skip {
+            skip = false;
+            continue;
+        }
+        if Some(i) == pos {
+            skip = true;
+            continue;
+        }
+        if !is(a, "--scheme=bspline") {
+            out.push(a.clone());
+        }
+    }
+    out
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -224,6 +264,32 @@ pub fn run(args: Args) -> Result<(), String> {
     println!("{text}");
     if let Some(path) = &args.json {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    let model = ExportModel {
+        curves: Vec::new(),
+        surfaces: vec![SurfaceDesc {
+            degree_u: surface.knots_u().degree(),
+            degree_v: surface.knots_v().degree(),
+            knots_u: surface.knots_u().knots().to_vec(),
+            knots_v: surface.knots_v().knots().to_vec(),
+            num_u: surface.num_control().0,
+            num_v: surface.num_control().1,
+            control_points: surface.control_points().to_vec(),
+            weights: surface.weights().map(<[f64]>::to_vec),
+        }],
+    };
+    let name = args
+        .file
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("geofit");
+    if let Some(path) = &args.iges {
+        let text = write_iges(&model, name).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if let Some(path) = &args.step {
+        let text = write_step(&model, name).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     if let Some(path) = &args.surface_json {
         let json = serde_json::to_string(&surface_json(&surface)).map_err(|e| e.to_string())?;

@@ -48,7 +48,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(fit_bspline::route(std::env::args_os().collect()));
     let result = match cli.command {
         Command::Info(args) => info::run(args),
         Command::FitCurve(args) => fit_curve::run(args),
