@@ -104,11 +104,9 @@ def greville(t, k, n):
 
 
 def scipy_surface(spline):
-    tx, ty = spline.get_knots()
+    # get_knots() gives the full clamped knot vectors (ends repeated k + 1 times).
+    tu, tv = (np.asarray(t, float) for t in spline.get_knots())
     kx, ky = spline.degrees
-    # FITPACK stores the clamped end knots once; repeat them k + 1 times.
-    tu = np.r_[[tx[0]] * kx, tx, [tx[-1]] * kx]
-    tv = np.r_[[ty[0]] * ky, ty, [ty[-1]] * ky]
     nu, nv = len(tu) - kx - 1, len(tv) - ky - 1
     c = spline.get_coeffs().reshape(nu, nv)
     gx, gy = greville(tu, kx, nu), greville(tv, ky, nv)
@@ -150,7 +148,10 @@ def occ_fit(pts, diag, grid_n, tol_pct):
     """OCC needs a complete regular grid: resample z(x, y) linearly, fill holes by nearest."""
     from OCP.GeomAPI import GeomAPI_PointsToBSplineSurface
     from OCP.GeomAbs import GeomAbs_C2
-    from OCP.TColgp import TColgp_Array2OfPnt
+    try:
+        from OCP.collections import Array2_gp_Pnt as TColgp_Array2OfPnt
+    except ImportError:
+        from OCP.TColgp import TColgp_Array2OfPnt
     from OCP.gp import gp_Pnt
 
     def resample():
@@ -188,6 +189,7 @@ def main():
     ap.add_argument("--counts", default="400,1600,6400")
     ap.add_argument("--json", help="also write the table as JSON to this file")
     ap.add_argument("--skip-smooth", action="store_true", help="skip SciPy SmoothBivariateSpline")
+    ap.add_argument("--peers-only", action="store_true", help="skip the geofit runs")
     args = ap.parse_args()
     pts = read_ascii_ply_vertices(args.data)
     diag = float(np.linalg.norm(pts.max(0) - pts.min(0)))
@@ -205,10 +207,11 @@ def main():
     x, y, zz = pts[:, 0], pts[:, 1], pts[:, 2]
     for n in counts:
         side = int(round(np.sqrt(n)))
-        s, rep, w, c = run_geofit(args.geofit, args.data, ["--ctrl", str(n), "--solves", "4"])
-        row("geofit least-squares (fixed)", n, s, w, c, f"internal {rep['total_s']:.2f} s, {rep['folded_points']} folded")
-        s, rep, w, c = run_geofit(args.geofit, args.data, ["--ctrl", str(n), "--method", "geometric"])
-        row("geofit geometric (fixed)", n, s, w, c, f"{rep['iterations']} iterations")
+        if not args.peers_only:
+            s, rep, w, c = run_geofit(args.geofit, args.data, ["--ctrl", str(n), "--solves", "4"])
+            row("geofit least-squares (fixed)", n, s, w, c, f"internal {rep['total_s']:.2f} s, {rep['folded_points']} folded")
+            s, rep, w, c = run_geofit(args.geofit, args.data, ["--ctrl", str(n), "--method", "geometric"])
+            row("geofit geometric (fixed)", n, s, w, c, f"{rep['iterations']} iterations")
         inner = side - 4
         tx = np.linspace(x.min(), x.max(), inner + 2)[1:-1]
         ty = np.linspace(y.min(), y.max(), inner + 2)[1:-1]
@@ -217,7 +220,7 @@ def main():
             row("scipy LSQBivariateSpline", n, scipy_surface(sp), w, c)
         except Exception as e:  # noqa: BLE001 - report what the peer does
             print(f"scipy LSQBivariateSpline {n}: failed: {e}")
-    for tol in (0.1, 0.05):
+    for tol in () if args.peers_only else (0.1, 0.05):
         for method in ("least-squares", "geometric"):
             s, rep, w, c = run_geofit(args.geofit, args.data, ["--tol-max", str(tol), "--tol-mode", "noisy", "--method", method])
             row(f"geofit {method} tol {tol} noisy", rep["final_control_points"], s, w, c,
