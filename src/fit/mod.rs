@@ -5,6 +5,7 @@
 
 mod accel;
 pub mod bspline_surface;
+mod build;
 pub mod closest;
 pub mod curve;
 mod curve_lsq;
@@ -22,6 +23,7 @@ mod stats;
 pub mod subdiv;
 
 pub use bspline_surface::{GeometricSurfaceFitter, GeometricSurfaceOptions};
+pub use build::{build_subdiv_fitter, default_initial_count, initial_control};
 pub use closest::FootPoint;
 pub use curve::{CurveFitOptions, CurveFitter};
 pub use curve_lsq::least_squares_curve;

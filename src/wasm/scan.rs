@@ -18,6 +18,13 @@ pub fn load_file(bytes: &[u8], name: &str) -> Result<LoadedScan, JsError> {
     Ok(LoadedScan { file })
 }
 
+impl LoadedScan {
+    /// The parsed points and faces.
+    pub(crate) fn mesh(&self) -> &crate::mesh::PolyMesh {
+        &self.file.mesh
+    }
+}
+
 #[wasm_bindgen]
 impl LoadedScan {
     /// The format the file was parsed as: "ply", "obj", "stl" or "xyz".

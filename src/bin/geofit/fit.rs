@@ -4,8 +4,8 @@
 
 use clap::ValueEnum;
 use geofit::fit::{
-    Acceleration, FitReport, FitStatus, Fitter, SubdivFitOptions, SubdivFitter, Tolerances,
-    Weighting,
+    build_subdiv_fitter, Acceleration, FitReport, FitStatus, Fitter, SubdivFitOptions,
+    SubdivFitter, Tolerances, Weighting,
 };
 use geofit::mesh::PolyMesh;
 use geofit::subdiv::{Scheme, SubdivSurface};
@@ -154,11 +154,6 @@ impl Args {
     }
 }
 
-/// The initial control-mesh size chosen from `n` data points (see `--help`).
-pub fn default_initial_count(n: usize, mesh_vertices: usize) -> usize {
-    (n / 60).clamp(50, 20_000).min(mesh_vertices)
-}
-
 fn read(path: &Path) -> Result<PolyMesh, String> {
     geofit::io::read_path(path)
         .map(|loaded| loaded.mesh)
@@ -168,40 +163,17 @@ fn read(path: &Path) -> Result<PolyMesh, String> {
 pub fn run(args: Args) -> Result<(), String> {
     let start = Instant::now();
     let data = read(&args.file)?;
-    let initial = match &args.control {
-        Some(path) => read(path)?,
-        None => initial_control(&data, args.initial)?,
-    };
+    let control = args.control.as_deref().map(read).transpose()?;
     let scheme = match args.scheme {
         SchemeArg::Loop => Scheme::Loop,
         SchemeArg::CatmullClark => Scheme::CatmullClark,
         SchemeArg::DooSabin => Scheme::DooSabin,
     };
-    let before_fitter = start.elapsed().as_secs_f64();
-    let fitter =
-        SubdivFitter::<SubdivSurface>::try_new(data.positions(), initial, scheme, args.options())
-            .map_err(|e| e.to_string())?;
+    let fitter = build_subdiv_fitter(&data, scheme, control, args.initial, args.options())
+        .map_err(|e| e.to_string())?;
+    // Reading and QEM count as precompute; the report adds the fitter's own set-up time.
+    let before_fitter = (start.elapsed().as_secs_f64() - fitter.precompute_seconds()).max(0.0);
     drive(fitter, before_fitter, &args)
-}
-
-/// The QEM-simplified data mesh with `target` vertices (or the default count).
-fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<PolyMesh, String> {
-    if data.is_point_cloud() {
-        return Err("the data has no faces; give a control mesh with --control".into());
-    }
-    let used = used_vertices(data);
-    let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
-    geofit::mesh::simplify::simplify(data, target).map_err(|e| format!("simplification: {e}"))
-}
-
-fn used_vertices(mesh: &PolyMesh) -> usize {
-    let mut used = vec![false; mesh.num_vertices()];
-    for f in mesh.faces() {
-        for &v in f {
-            used[v as usize] = true;
-        }
-    }
-    used.iter().filter(|&&u| u).count()
 }
 
 /// Iterates to the end, printing progress, then writes the outputs.
