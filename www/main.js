@@ -2,6 +2,7 @@
 // with the wgpu viewer. The page opens with a bundled sample; a file picker and drag-and-drop load
 // others; a file that cannot be read leaves the previous one on screen and says why.
 import init, { Viewer, loadFile } from '../pkg/geofit.js';
+import { createFitUi } from './fit-ui.js';
 
 const DEFAULT_SAMPLE = 'samples/bunny.obj';
 // Height colours, low to high (sRGB): blue, teal, amber.
@@ -26,6 +27,7 @@ const ui = {
 };
 
 let viewer = null;
+let fitUi = null;
 let frameRequest = 0;
 let framesDrawn = 0;
 
@@ -102,6 +104,7 @@ function show(bytes, name) {
     clearError();
     setState('ready');
     requestRender();
+    fitUi?.onScan(bytes, name, positions);
     return true;
   } catch (e) {
     showError(`Could not show ${name}: ${e?.message ?? e}`);
@@ -210,6 +213,7 @@ async function main() {
   await init();
   bindFiles();
   bindCamera();
+  fitUi = createFitUi({ viewer: () => viewer, requestRender, showError, canvas: ui.canvas });
   for (const box of [ui.showPoints, ui.showMesh, ui.showWireframe]) {
     box.addEventListener('change', updateLayers);
   }

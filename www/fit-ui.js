@@ -1,0 +1,306 @@
+// The fitting panel: options, play / pause / step / reset, statistics, the convergence chart, the
+// error colours and exports. The fit itself runs in fit-worker.js; this module only turns the
+// worker's frames into draw calls on the shared Viewer and into text, so no main-thread task
+// grows with the fit.
+
+const SCHEME_NAMES = { loop: 'Loop', 'catmull-clark': 'Catmull–Clark', 'doo-sabin': 'Doo–Sabin' };
+// Diverging map for signed distance: inside the E_max tolerance pale tints, outside saturated.
+const INSIDE_NEG = [0.62, 0.78, 1.0];
+const INSIDE_ZERO = [0.92, 0.92, 0.9];
+const INSIDE_POS = [1.0, 0.74, 0.62];
+const OUTSIDE_NEG = [0.05, 0.25, 0.95];
+const OUTSIDE_POS = [0.9, 0.08, 0.05];
+const VECTOR_COLOR = [1.0, 0.85, 0.2];
+const CAGE_COLOR = [0.35, 0.95, 0.55];
+const CHART_COLORS = { eAvgPct: '#4ea1ff', eMaxPct: '#ff6b5b', eRmsPct: '#7ee07e' };
+
+const el = (id) => document.getElementById(id);
+
+function mix(a, b, t) {
+  return [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t];
+}
+
+/** One sRGB colour per data point from its signed distance `d` and the tolerance `tol` (units). */
+export function errorColors(errors, tol) {
+  const colors = new Float32Array(errors.length * 3);
+  for (let i = 0; i < errors.length; i += 1) {
+    const t = tol > 0 ? errors[i] / tol : 0;
+    let c;
+    if (t > 1) c = OUTSIDE_POS;
+    else if (t < -1) c = OUTSIDE_NEG;
+    else if (t >= 0) c = mix(INSIDE_ZERO, INSIDE_POS, t);
+    else c = mix(INSIDE_ZERO, INSIDE_NEG, -t);
+    colors.set(c, i * 3);
+  }
+  return colors;
+}
+
+/** Line-set vertices and colours for the control-mesh edges and/or the error vectors. */
+function lineSet(frame, showCage, showVectors) {
+  const parts = [];
+  if (showCage) {
+    const { positions, edges } = frame.control;
+    const out = new Float32Array(edges.length * 3);
+    for (let k = 0; k < edges.length; k += 1) out.set(positions.subarray(edges[k] * 3, edges[k] * 3 + 3), k * 3);
+    parts.push([out, CAGE_COLOR]);
+  }
+  if (showVectors) parts.push([frame.vectors, VECTOR_COLOR]);
+  const total = parts.reduce((n, [p]) => n + p.length, 0);
+  const positions = new Float32Array(total);
+  const colors = new Float32Array(total);
+  let at = 0;
+  for (const [p, color] of parts) {
+    positions.set(p, at);
+    for (let i = at; i < at + p.length; i += 3) colors.set(color, i);
+    at += p.length;
+  }
+  return { positions, colors };
+}
+
+function fmtPct(v) {
+  return `${v.toPrecision(4)} %`;
+}
+
+function fmtUnits(v) {
+  return v === 0 ? '0' : v.toExponential(3);
+}
+
+/** Draws E_avg, E_max, E_rms (log scale) against iteration, tolerance lines and refinements. */
+export function drawChart(canvas, history, tolerances) {
+  const ratio = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * ratio));
+  const h = Math.max(1, Math.round(canvas.clientHeight * ratio));
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+  }
+  const g = canvas.getContext('2d');
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  const cw = w / ratio;
+  const ch = h / ratio;
+  g.fillStyle = '#10141b';
+  g.fillRect(0, 0, cw, ch);
+  const pad = { l: 44, r: 8, t: 8, b: 20 };
+  const values = history.flatMap((r) => [r.eAvgPct, r.eMaxPct, r.eRmsPct]);
+  for (const t of Object.values(tolerances)) if (t > 0) values.push(t);
+  const positive = values.filter((v) => v > 0);
+  if (positive.length === 0) return;
+  let lo = Math.log10(Math.min(...positive));
+  let hi = Math.log10(Math.max(...positive));
+  lo = Math.floor(lo);
+  hi = Math.max(Math.ceil(hi), lo + 1);
+  const n = Math.max(history.length, 1);
+  const x = (i) => pad.l + ((i) / n) * (cw - pad.l - pad.r);
+  const y = (v) => pad.t + ((hi - Math.log10(Math.max(v, 10 ** lo))) / (hi - lo)) * (ch - pad.t - pad.b);
+  g.font = '10px system-ui, sans-serif';
+  g.fillStyle = '#9aa3ad';
+  g.strokeStyle = '#2a313c';
+  g.lineWidth = 1;
+  for (let e = lo; e <= hi; e += 1) {
+    g.beginPath();
+    g.moveTo(pad.l, y(10 ** e));
+    g.lineTo(cw - pad.r, y(10 ** e));
+    g.stroke();
+    g.fillText(`${10 ** e >= 1 ? 10 ** e : (10 ** e).toPrecision(1)}%`, 2, y(10 ** e) + 3);
+  }
+  g.fillText('iteration', cw - 50, ch - 4);
+  // Refinement events: dashed vertical lines.
+  g.setLineDash([3, 3]);
+  g.strokeStyle = '#c9a0ff';
+  for (const r of history) {
+    if (!r.refined) continue;
+    g.beginPath();
+    g.moveTo(x(r.iter), pad.t);
+    g.lineTo(x(r.iter), ch - pad.b);
+    g.stroke();
+  }
+  // Tolerances: dashed horizontal lines in the colour of their figure.
+  const tolKey = { avg: 'eAvgPct', max: 'eMaxPct', rms: 'eRmsPct' };
+  for (const [k, t] of Object.entries(tolerances)) {
+    if (!(t > 0)) continue;
+    g.strokeStyle = CHART_COLORS[tolKey[k]];
+    g.beginPath();
+    g.moveTo(pad.l, y(t));
+    g.lineTo(cw - pad.r, y(t));
+    g.stroke();
+  }
+  g.setLineDash([]);
+  g.lineWidth = 2;
+  for (const [key, color] of Object.entries(CHART_COLORS)) {
+    g.strokeStyle = color;
+    g.beginPath();
+    history.forEach((r, i) => (i === 0 ? g.moveTo(x(r.iter), y(r[key])) : g.lineTo(x(r.iter), y(r[key]))));
+    if (history.length === 1) g.lineTo(x(history[0].iter) + 2, y(history[0][key]));
+    g.stroke();
+  }
+}
+
+function download(bytes, name, type) {
+  const url = URL.createObjectURL(new Blob([bytes], { type }));
+  const a = document.createElement('a');
+  a.href = url;
+  a.download = name;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10_000);
+}
+
+/**
+ * Wires the fitting panel. `host` gives the viewer, a render request and the error line.
+ * Returns `{ onScan(bytes, name) }`: called by the page after every successfully loaded file.
+ */
+export function createFitUi(host) {
+  const ui = {
+    scheme: el('fit-scheme'), tolAvg: el('fit-tol-avg'), tolMax: el('fit-tol-max'),
+    initial: el('fit-initial'), maxIter: el('fit-max-iter'), refine: el('fit-refine'),
+    maxControl: el('fit-max-control'), weights: el('fit-weights'), accel: el('fit-accel'),
+    play: el('fit-play'), step: el('fit-step'), reset: el('fit-reset'),
+    vectors: el('show-vectors'), cage: el('show-cage'), chart: el('fit-chart'),
+    status: el('fit-status'), iter: el('fit-iter'), ctrl: el('fit-ctrl'), eAvg: el('fit-eavg'),
+    eMax: el('fit-emax'), eRms: el('fit-erms'), ms: el('fit-ms'), total: el('fit-total'),
+    legendTol: el('legend-tol'), legendNeg: el('legend-neg'),
+  };
+  const worker = new Worker(new URL('./fit-worker.js', import.meta.url), { type: 'module' });
+  let scan = null;
+  let frame = null;
+  let playing = false;
+  let tolerances = {};
+  // lastStats/history: the worker's latest figures; maxFrameMs: the longest frame handler here.
+  const state = { lastStats: null, history: [], frames: 0, maxFrameMs: 0 };
+  window.geofitFit = state;
+
+  function options() {
+    const num = (input) => (input.value.trim() === '' ? undefined : Number(input.value));
+    const opts = {
+      scheme: ui.scheme.value,
+      tolAvg: num(ui.tolAvg),
+      tolMax: num(ui.tolMax),
+      initial: num(ui.initial),
+      maxIter: num(ui.maxIter),
+      refine: ui.refine.checked,
+      maxControl: ui.refine.checked ? num(ui.maxControl) : undefined,
+      weights: ui.weights.value,
+      acceleration: ui.accel.value === 'default' ? undefined : ui.accel.value,
+    };
+    return Object.fromEntries(Object.entries(opts).filter(([, v]) => v !== undefined));
+  }
+
+  function setFitState(s) {
+    document.body.dataset.fit = s;
+    ui.status.textContent = {
+      building: 'building the control mesh…', paused: 'paused', running: 'fitting…',
+      converged: 'converged: tolerances met', max_iterations: 'stopped: iteration cap reached',
+      error: 'error', idle: '—',
+    }[s] ?? s;
+    ui.play.textContent = s === 'running' ? 'Pause' : 'Play';
+    ui.play.setAttribute('aria-pressed', String(s === 'running'));
+  }
+
+  function restart() {
+    if (!scan) return;
+    playing = false;
+    frame = null;
+    const opts = options();
+    tolerances = { avg: opts.tolAvg, max: opts.tolMax };
+    setFitState('building');
+    worker.postMessage({ type: 'start', bytes: scan.bytes.slice(), name: scan.name, options: opts });
+  }
+
+  function redraw() {
+    const viewer = host.viewer();
+    if (!viewer || !frame) return;
+    const tolUnits = ((tolerances.max ?? 0.05) * frame.stats.diagonal) / 100;
+    viewer.setPoints(frame.data, errorColors(frame.errors, tolUnits));
+    viewer.setMesh(frame.limit.positions, frame.limit.normals, frame.limit.indices);
+    const lines = lineSet(frame, ui.cage.checked, ui.vectors.checked);
+    viewer.setLines(lines.positions, lines.colors);
+    host.requestRender();
+  }
+
+  function showStats(s) {
+    ui.iter.textContent = String(s.iter);
+    ui.ctrl.textContent = s.controlPoints.toLocaleString('en-US');
+    ui.eAvg.textContent = `${fmtPct(s.eAvgPct)} (${fmtUnits(s.eAvg)} units)`;
+    ui.eMax.textContent = `${fmtPct(s.eMaxPct)} (${fmtUnits(s.eMax)} units)`;
+    ui.eRms.textContent = `${fmtPct(s.eRmsPct)} (${fmtUnits(s.eRms)} units)`;
+    ui.ms.textContent = `${s.ms.toFixed(1)} ms`;
+    ui.total.textContent = `${(s.totalMs / 1000).toFixed(2)} s`;
+    const tolUnits = ((tolerances.max ?? 0.05) * s.diagonal) / 100;
+    ui.legendTol.textContent = `+${fmtUnits(tolUnits)}`;
+    ui.legendNeg.textContent = `−${fmtUnits(tolUnits)}`;
+    document.body.dataset.fitIter = String(s.iter);
+  }
+
+  worker.onmessage = ({ data: m }) => {
+    if (m.type === 'frame') {
+      const t0 = performance.now();
+      frame = { ...m, data: scan.positions };
+      state.lastStats = m.stats;
+      state.history = m.history;
+      state.frames += 1;
+      showStats(m.stats);
+      drawChart(ui.chart, m.history, tolerances);
+      redraw();
+      playing = m.playing;
+      const status = m.stats.status;
+      setFitState(status === 'running' ? (playing ? 'running' : 'paused') : status);
+      state.maxFrameMs = Math.max(state.maxFrameMs, performance.now() - t0);
+    } else if (m.type === 'exported') {
+      const names = {
+        cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
+        ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
+        json: ['geofit-report.json', 'application/json'],
+      }[m.what];
+      download(m.bytes, ...names);
+    } else if (m.type === 'error') {
+      host.showError(`Fit (${m.during}): ${m.message}`);
+      playing = false;
+      setFitState(frame ? 'paused' : 'error');
+    }
+  };
+  worker.onerror = (e) => {
+    host.showError(`The fitting worker failed: ${e.message}`);
+    setFitState('error');
+  };
+
+  ui.play.addEventListener('click', () => {
+    if (!frame) return;
+    if (playing) worker.postMessage({ type: 'pause' });
+    else {
+      worker.postMessage({ type: 'play' });
+      playing = true;
+      setFitState('running');
+    }
+  });
+  ui.step.addEventListener('click', () => frame && worker.postMessage({ type: 'step' }));
+  ui.reset.addEventListener('click', restart);
+  for (const input of [ui.scheme, ui.tolAvg, ui.tolMax, ui.initial, ui.maxIter, ui.refine,
+    ui.maxControl, ui.weights, ui.accel]) {
+    input.addEventListener('change', restart);
+  }
+  ui.refine.addEventListener('change', () => { ui.maxControl.disabled = !ui.refine.checked; });
+  for (const box of [ui.cage, ui.vectors]) box.addEventListener('change', redraw);
+  for (const button of document.querySelectorAll('[data-export]')) {
+    button.addEventListener('click', () => worker.postMessage({ type: 'export', what: button.dataset.export }));
+  }
+  el('fit-screenshot').addEventListener('click', () => {
+    const viewer = host.viewer();
+    if (!viewer) return;
+    // Render and read back in the same task: the drawing buffer is still valid.
+    viewer.render();
+    host.canvas.toBlob(async (blob) => {
+      if (blob) download(new Uint8Array(await blob.arrayBuffer()), 'geofit-view.png', 'image/png');
+    }, 'image/png');
+  });
+  new ResizeObserver(() => state.history.length && drawChart(ui.chart, state.history, tolerances)).observe(ui.chart);
+  setFitState('idle');
+
+  return {
+    onScan(bytes, name, positions) {
+      scan = { bytes, name, positions };
+      ui.scheme.title = SCHEME_NAMES[ui.scheme.value];
+      restart();
+    },
+  };
+}
