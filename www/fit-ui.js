@@ -3,7 +3,6 @@
 // worker's frames into draw calls on the shared Viewer and into text, so no main-thread task
 // grows with the fit.
 
-const SCHEME_NAMES = { loop: 'Loop', 'catmull-clark': 'Catmull–Clark', 'doo-sabin': 'Doo–Sabin' };
 // Diverging map for signed distance: inside the E_max tolerance pale tints, outside saturated.
 const INSIDE_NEG = [0.62, 0.78, 1.0];
 const INSIDE_ZERO = [0.92, 0.92, 0.9];
@@ -148,7 +147,8 @@ function download(bytes, name, type) {
 
 /**
  * Wires the fitting panel. `host` gives the viewer, a render request and the error line.
- * Returns `{ onScan(bytes, name) }`: called by the page after every successfully loaded file.
+ * Returns `{ onScan(bytes, name) }`: called by the page after every successfully loaded file; the
+ * scan stays on screen as loaded until a fit is started.
  */
 export function createFitUi(host) {
   const ui = {
@@ -166,6 +166,12 @@ export function createFitUi(host) {
   let frame = null;
   let playing = false;
   let tolerances = {};
+  // generation: the fit the worker was last asked to build (0: none for this scan); frames of
+  // older fits are dropped. pending: the newest frame not yet drawn (drawn at most once a frame).
+  let generation = 0;
+  let built = 0;
+  let pending = null;
+  let data = null;
   // lastStats/history: the worker's latest figures; maxFrameMs: the longest frame handler here.
   const state = { lastStats: null, history: [], frames: 0, maxFrameMs: 0 };
   window.geofitFit = state;
@@ -191,20 +197,41 @@ export function createFitUi(host) {
     ui.status.textContent = {
       building: 'building the control mesh…', paused: 'paused', running: 'fitting…',
       converged: 'converged: tolerances met', max_iterations: 'stopped: iteration cap reached',
-      error: 'error', idle: '—',
+      error: 'error', idle: 'press Play or Step to fit',
     }[s] ?? s;
     ui.play.textContent = s === 'running' ? 'Pause' : 'Play';
     ui.play.setAttribute('aria-pressed', String(s === 'running'));
   }
 
+  /** Asks the worker for a new fit of the current scan with the panel's options (iteration 0). */
   function restart() {
     if (!scan) return;
     playing = false;
     frame = null;
+    pending = null;
     const opts = options();
     tolerances = { avg: opts.tolAvg, max: opts.tolMax };
+    generation += 1;
+    built = generation;
     setFitState('building');
-    worker.postMessage({ type: 'start', bytes: scan.bytes.slice(), name: scan.name, options: opts });
+    worker.postMessage({ type: 'start', generation, bytes: scan.bytes.slice(), name: scan.name, options: opts });
+  }
+
+  /** Forgets the fit (a new scan was loaded): the page shows the scan until Play, Step or Reset. */
+  function clear() {
+    generation += 1;
+    built = 0;
+    playing = false;
+    frame = null;
+    pending = null;
+    data = null;
+    worker.postMessage({ type: 'clear', generation });
+    Object.assign(state, { lastStats: null, history: [] });
+    for (const dd of [ui.iter, ui.ctrl, ui.eAvg, ui.eMax, ui.eRms, ui.ms, ui.total]) dd.textContent = '—';
+    delete document.body.dataset.fitIter;
+    const g = ui.chart.getContext('2d');
+    g.clearRect(0, 0, ui.chart.width, ui.chart.height);
+    setFitState('idle');
   }
 
   function redraw() {
@@ -232,20 +259,33 @@ export function createFitUi(host) {
     document.body.dataset.fitIter = String(s.iter);
   }
 
+  /** Shows the newest frame: statistics, chart and scene (one animation frame, however many came). */
+  function applyFrame() {
+    const m = pending;
+    pending = null;
+    if (!m || m.generation !== generation) return;
+    const t0 = performance.now();
+    if (m.data) data = m.data;
+    frame = { ...m, data };
+    state.lastStats = m.stats;
+    state.history = m.history;
+    state.frames += 1;
+    showStats(m.stats);
+    drawChart(ui.chart, m.history, tolerances);
+    redraw();
+    playing = m.playing;
+    const status = m.stats.status;
+    setFitState(status === 'running' ? (playing ? 'running' : 'paused') : status);
+    state.maxFrameMs = Math.max(state.maxFrameMs, performance.now() - t0);
+  }
+
   worker.onmessage = ({ data: m }) => {
     if (m.type === 'frame') {
-      const t0 = performance.now();
-      frame = { ...m, data: scan.positions };
-      state.lastStats = m.stats;
-      state.history = m.history;
-      state.frames += 1;
-      showStats(m.stats);
-      drawChart(ui.chart, m.history, tolerances);
-      redraw();
-      playing = m.playing;
-      const status = m.stats.status;
-      setFitState(status === 'running' ? (playing ? 'running' : 'paused') : status);
-      state.maxFrameMs = Math.max(state.maxFrameMs, performance.now() - t0);
+      if (m.generation !== generation) return;
+      // The data points come with a fit's first frame only; keep them if a newer frame overtakes it.
+      if (pending?.data && !m.data) m.data = pending.data;
+      if (!pending) requestAnimationFrame(applyFrame);
+      pending = m;
     } else if (m.type === 'exported') {
       const names = {
         cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
@@ -254,8 +294,10 @@ export function createFitUi(host) {
       }[m.what];
       download(m.bytes, ...names);
     } else if (m.type === 'error') {
+      if (m.generation !== generation) return;
       host.showError(`Fit (${m.during}): ${m.message}`);
       playing = false;
+      if (m.during === 'start') built = 0;
       setFitState(frame ? 'paused' : 'error');
     }
   };
@@ -265,19 +307,24 @@ export function createFitUi(host) {
   };
 
   ui.play.addEventListener('click', () => {
-    if (!frame) return;
+    if (!scan) return;
     if (playing) worker.postMessage({ type: 'pause' });
     else {
+      if (!built) restart();
       worker.postMessage({ type: 'play' });
       playing = true;
       setFitState('running');
     }
   });
-  ui.step.addEventListener('click', () => frame && worker.postMessage({ type: 'step' }));
+  ui.step.addEventListener('click', () => {
+    if (!scan) return;
+    if (!built) restart();
+    worker.postMessage({ type: 'step' });
+  });
   ui.reset.addEventListener('click', restart);
   for (const input of [ui.scheme, ui.tolAvg, ui.tolMax, ui.initial, ui.maxIter, ui.refine,
     ui.maxControl, ui.weights, ui.accel]) {
-    input.addEventListener('change', restart);
+    input.addEventListener('change', () => built && restart());
   }
   ui.refine.addEventListener('change', () => { ui.maxControl.disabled = !ui.refine.checked; });
   for (const box of [ui.cage, ui.vectors]) box.addEventListener('change', redraw);
@@ -297,10 +344,9 @@ export function createFitUi(host) {
   setFitState('idle');
 
   return {
-    onScan(bytes, name, positions) {
-      scan = { bytes, name, positions };
-      ui.scheme.title = SCHEME_NAMES[ui.scheme.value];
-      restart();
+    onScan(bytes, name) {
+      scan = { bytes, name };
+      clear();
     },
   };
 }

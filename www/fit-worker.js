@@ -2,7 +2,8 @@
 // `run(budget)` slice (at least one iteration, at most ~40 ms of work when iterations are fast) it
 // posts a frame: statistics, history, signed point errors, the limit mesh, the control-mesh edges
 // and the error vectors, all as transferable typed arrays. Messages in: start, play, pause, step,
-// export. Messages out: frame, exported, error.
+// export, clear. Messages out: frame, exported, error (each with the `generation` of the
+// fit it belongs to, so that the page can drop what an older fit sent).
 import init, { Fitter, loadFile } from '../pkg/geofit.js';
 
 const SLICE_MS = 40;
@@ -15,7 +16,7 @@ const ready = init();
 
 function fail(error, during) {
   playing = false;
-  postMessage({ type: 'error', during, message: String(error?.message ?? error) });
+  postMessage({ type: 'error', during, generation, message: String(error?.message ?? error) });
 }
 
 /** Posts the current state of the fit; typed arrays move to the main thread without copying. */
@@ -34,6 +35,8 @@ function postFrame(kind) {
     control: { positions: control.positions, edges: control.edges },
     vectors: fitter.errorVectors(),
   };
+  // The data points (in the order of `errors`) travel once per fit.
+  if (kind === 'start') frame.data = fitter.dataPositions();
   limit.free();
   control.free();
   const transfer = [
@@ -41,6 +44,7 @@ function postFrame(kind) {
     frame.limit.indices.buffer, frame.control.positions.buffer, frame.control.edges.buffer,
     frame.vectors.buffer,
   ];
+  if (frame.data) transfer.push(frame.data.buffer);
   postMessage(frame, transfer);
 }
 
@@ -60,11 +64,8 @@ function play(gen) {
 }
 
 const handlers = {
-  start({ bytes, name, options }) {
-    playing = false;
-    generation += 1;
-    fitter?.free();
-    fitter = null;
+  start({ generation: gen, bytes, name, options }) {
+    handlers.clear({ generation: gen });
     const scan = loadFile(bytes, name);
     try {
       fitter = new Fitter(scan, options);
@@ -72,6 +73,12 @@ const handlers = {
       scan.free();
     }
     postFrame('start');
+  },
+  clear({ generation: gen }) {
+    playing = false;
+    generation = gen ?? generation + 1;
+    fitter?.free();
+    fitter = null;
   },
   play() {
     if (!fitter || playing) return;

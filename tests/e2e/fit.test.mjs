@@ -74,7 +74,7 @@ describe('fitting page, WebGL2', () => {
       }).observe({ type: 'longtask', buffered: true });
     });
     await page.goto(started.url);
-    await page.waitForSelector('body[data-fit="paused"]', { timeout: TIMEOUT_MS });
+    await page.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
   });
 
   after(async () => {
@@ -83,6 +83,8 @@ describe('fitting page, WebGL2', () => {
   });
 
   test('before the fit, points outside the tolerance show saturated colours', async () => {
+    await page.click('#fit-reset');
+    await page.waitForSelector('body[data-fit="paused"]', { timeout: TIMEOUT_MS });
     await page.uncheck('#show-mesh');
     await page.waitForTimeout(300);
     const px = await errorPixels(page, 'fit-initial-errors.png');
