@@ -2,6 +2,7 @@
 //! with each scheme's refinement and remeshing.
 
 use super::refine::{improve_by_flips, split_triangles, SplitRule};
+use super::refine_quad::split_quads;
 use super::subdiv::{ControlSurface, SubdivFitter};
 use super::{FitError, SubdivFitOptions};
 use crate::geom::Point3;
@@ -49,17 +50,19 @@ impl ControlSurface for SubdivSurface {
         }
     }
 
-    /// Loop: red–green splitting with Loop's masks. Quad schemes: one refinement step of the
-    /// whole mesh (it reproduces the limit surface exactly; local conforming quad refinement is
-    /// not implemented), made only when it fits the caller's budget.
+    /// Loop: red–green splitting with Loop's masks. Catmull–Clark: local conforming quad
+    /// splitting with transition templates and Catmull–Clark's masks. Doo–Sabin: one
+    /// refinement step of the whole mesh (it reproduces the limit surface exactly), made only
+    /// when it fits the caller's budget.
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
         match self.scheme() {
             Scheme::Loop => split_triangles(control, marked, SplitRule::Loop),
-            scheme => {
+            Scheme::CatmullClark => split_quads(control, marked),
+            Scheme::DooSabin => {
                 let mesh = ControlMesh::try_new(control).map_err(|e| FitError::ControlMesh {
                     reason: e.to_string(),
                 })?;
-                refine(scheme, &mesh)?
+                refine(Scheme::DooSabin, &mesh)?
                     .to_poly_mesh()
                     .map_err(|e| FitError::ControlMesh {
                         reason: e.to_string(),
