@@ -1,5 +1,6 @@
 // The fitting panel: options, play / pause / step / reset, statistics, the convergence chart, the
-// error colours and exports. The fit itself runs in fit-worker.js; this module only turns the
+// error colours, the view toggles of the fit (control net, error vectors, iso-parameter lines,
+// initial mesh) and exports. The fit itself runs in fit-worker.js; this module only turns the
 // worker's frames into draw calls on the shared Viewer and into text, so no main-thread task
 // grows with the fit.
 
@@ -11,6 +12,21 @@ const OUTSIDE_NEG = [0.05, 0.25, 0.95];
 const OUTSIDE_POS = [0.9, 0.08, 0.05];
 const VECTOR_COLOR = [1.0, 0.85, 0.2];
 const CAGE_COLOR = [0.35, 0.95, 0.55];
+const ISO_COLOR = [0.3, 0.85, 1.0];
+const INITIAL_COLOR = [0.75, 0.55, 1.0];
+const CURVE_COLOR = [1.0, 0.55, 0.1];
+const SUBDIV = ['loop', 'catmull-clark', 'doo-sabin'];
+const CURVES = ['bspline-curve', 'chaikin-curve'];
+// Download name and MIME type of each export.
+const EXPORTS = {
+  cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
+  ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
+  iges: ['geofit.igs', 'model/iges'], step: ['geofit.stp', 'model/step'],
+  json: ['geofit-report.json', 'application/json'],
+};
+// The chart is drawn on the CPU: a GPU-accelerated 2D canvas makes the main thread wait for the
+// GPU process (seconds under software rendering on a loaded machine) when the page is composited.
+const CHART_CONTEXT = { willReadFrequently: true };
 const CHART_COLORS = { eAvgPct: '#4ea1ff', eMaxPct: '#ff6b5b', eRmsPct: '#7ee07e' };
 
 const el = (id) => document.getElementById(id);
@@ -34,16 +50,15 @@ export function errorColors(errors, tol) {
   return colors;
 }
 
-/** Line-set vertices and colours for the control-mesh edges and/or the error vectors. */
-function lineSet(frame, showCage, showVectors) {
-  const parts = [];
-  if (showCage) {
-    const { positions, edges } = frame.control;
-    const out = new Float32Array(edges.length * 3);
-    for (let k = 0; k < edges.length; k += 1) out.set(positions.subarray(edges[k] * 3, edges[k] * 3 + 3), k * 3);
-    parts.push([out, CAGE_COLOR]);
-  }
-  if (showVectors) parts.push([frame.vectors, VECTOR_COLOR]);
+/** Segment end points (two per edge) of the indexed `edges` over flat `positions`. */
+function edgeSegments(positions, edges) {
+  const out = new Float32Array(edges.length * 3);
+  for (let k = 0; k < edges.length; k += 1) out.set(positions.subarray(edges[k] * 3, edges[k] * 3 + 3), k * 3);
+  return out;
+}
+
+/** One line set from `[segments, colour]` parts: flat positions and a colour per vertex. */
+function lineSet(parts) {
   const total = parts.reduce((n, [p]) => n + p.length, 0);
   const positions = new Float32Array(total);
   const colors = new Float32Array(total);
@@ -73,7 +88,7 @@ export function drawChart(canvas, history, tolerances) {
     canvas.width = w;
     canvas.height = h;
   }
-  const g = canvas.getContext('2d');
+  const g = canvas.getContext('2d', CHART_CONTEXT);
   g.setTransform(ratio, 0, 0, ratio, 0, 0);
   const cw = w / ratio;
   const ch = h / ratio;
@@ -147,16 +162,20 @@ function download(bytes, name, type) {
 
 /**
  * Wires the fitting panel. `host` gives the viewer, a render request and the error line.
- * Returns `{ onScan(bytes, name) }`: called by the page after every successfully loaded file; the
- * scan stays on screen as loaded until a fit is started.
+ * Returns `{ onScan(bytes, name, diagonal, preset) }`: called by the page after every
+ * successfully loaded file (`preset`: form values suiting a bundled sample); the scan stays on
+ * screen as loaded until a fit is started.
  */
 export function createFitUi(host) {
   const ui = {
-    scheme: el('fit-scheme'), tolAvg: el('fit-tol-avg'), tolMax: el('fit-tol-max'),
+    form: el('fit-form'), scheme: el('fit-scheme'), method: el('fit-method'), closed: el('fit-closed'),
+    tolAvg: el('fit-tol-avg'), tolMax: el('fit-tol-max'),
+    tolAvgUnits: el('fit-tol-avg-units'), tolMaxUnits: el('fit-tol-max-units'),
     initial: el('fit-initial'), maxIter: el('fit-max-iter'), refine: el('fit-refine'),
     maxControl: el('fit-max-control'), weights: el('fit-weights'), accel: el('fit-accel'),
     play: el('fit-play'), step: el('fit-step'), reset: el('fit-reset'),
-    vectors: el('show-vectors'), cage: el('show-cage'), chart: el('fit-chart'),
+    vectors: el('show-vectors'), cage: el('show-cage'), iso: el('show-iso'), initialMesh: el('show-initial'),
+    chart: el('fit-chart'),
     status: el('fit-status'), iter: el('fit-iter'), ctrl: el('fit-ctrl'), eAvg: el('fit-eavg'),
     eMax: el('fit-emax'), eRms: el('fit-erms'), ms: el('fit-ms'), total: el('fit-total'),
     legendTol: el('legend-tol'), legendNeg: el('legend-neg'),
@@ -171,31 +190,69 @@ export function createFitUi(host) {
   let generation = 0;
   let built = 0;
   let pending = null;
-  let data = null;
-  // lastStats/history: the worker's latest figures; maxFrameMs: the longest frame handler here.
-  const state = { lastStats: null, history: [], frames: 0, maxFrameMs: 0 };
+  // Sent once per fit: the data points (in the order of the errors) and the initial control net.
+  let once = null;
+  // lastStats/history: the worker's latest figures; frames: frames shown; maxStageMs: the
+  // longest stage of showing one.
+  const state = { lastStats: null, history: [], frames: 0, maxStageMs: 0 };
   window.geofitFit = state;
 
   function options() {
     const num = (input) => (input.value.trim() === '' ? undefined : Number(input.value));
+    const scheme = ui.scheme.value;
     const opts = {
-      scheme: ui.scheme.value,
-      tolAvg: num(ui.tolAvg),
+      scheme,
+      method: scheme === 'bspline-surface' ? ui.method.value : undefined,
+      closed: CURVES.includes(scheme) ? ui.closed.checked : undefined,
+      tolAvg: scheme === 'bspline-surface' ? undefined : num(ui.tolAvg),
       tolMax: num(ui.tolMax),
-      initial: num(ui.initial),
+      initial: CURVES.includes(scheme) ? undefined : num(ui.initial),
       maxIter: num(ui.maxIter),
       refine: ui.refine.checked,
       maxControl: ui.refine.checked ? num(ui.maxControl) : undefined,
-      weights: ui.weights.value,
+      weights: SUBDIV.includes(scheme) ? ui.weights.value : undefined,
       acceleration: ui.accel.value === 'default' ? undefined : ui.accel.value,
     };
     return Object.fromEntries(Object.entries(opts).filter(([, v]) => v !== undefined));
   }
 
+  /** Shows the options and exports that apply to the chosen scheme. */
+  function schemeChanged() {
+    const scheme = ui.scheme.value;
+    for (const label of ui.form.querySelectorAll('[data-for]')) {
+      label.hidden = !label.dataset.for.split(' ').includes(scheme);
+    }
+    const spline = !SUBDIV.includes(scheme);
+    const curve = CURVES.includes(scheme);
+    for (const button of document.querySelectorAll('[data-export]')) {
+      const what = button.dataset.export;
+      button.disabled = ((what === 'iges' || what === 'step') && !spline) ||
+        (['obj', 'ply', 'stl'].includes(what) && curve);
+    }
+    ui.tolAvg.disabled = scheme === 'bspline-surface';
+    ui.tolAvgUnits.disabled = scheme === 'bspline-surface';
+    ui.initial.disabled = curve;
+  }
+
+  /** Keeps each tolerance's % and model-unit fields in step (the diagonal is the scan's). */
+  function linkTolerance(pct, units) {
+    const toUnits = () => {
+      const d = scan?.diagonal ?? 0;
+      units.value = pct.value.trim() === '' || !(d > 0) ? '' : String(Number(((Number(pct.value) * d) / 100).toPrecision(4)));
+    };
+    pct.addEventListener('input', toUnits);
+    units.addEventListener('input', () => {
+      const d = scan?.diagonal ?? 0;
+      if (units.value.trim() !== '' && d > 0) pct.value = String(Number(((Number(units.value) / d) * 100).toPrecision(4)));
+    });
+    return toUnits;
+  }
+  const tolUnits = [linkTolerance(ui.tolAvg, ui.tolAvgUnits), linkTolerance(ui.tolMax, ui.tolMaxUnits)];
+
   function setFitState(s) {
     document.body.dataset.fit = s;
     ui.status.textContent = {
-      building: 'building the control mesh…', paused: 'paused', running: 'fitting…',
+      building: 'building the control net…', paused: 'paused', running: 'fitting…',
       converged: 'converged: tolerances met', max_iterations: 'stopped: iteration cap reached',
       error: 'error', idle: 'press Play or Step to fit',
     }[s] ?? s;
@@ -209,6 +266,7 @@ export function createFitUi(host) {
     playing = false;
     frame = null;
     pending = null;
+    once = null;
     const opts = options();
     tolerances = { avg: opts.tolAvg, max: opts.tolMax };
     generation += 1;
@@ -224,24 +282,51 @@ export function createFitUi(host) {
     playing = false;
     frame = null;
     pending = null;
-    data = null;
+    once = null;
     worker.postMessage({ type: 'clear', generation });
     Object.assign(state, { lastStats: null, history: [] });
     for (const dd of [ui.iter, ui.ctrl, ui.eAvg, ui.eMax, ui.eRms, ui.ms, ui.total]) dd.textContent = '—';
     delete document.body.dataset.fitIter;
-    const g = ui.chart.getContext('2d');
+    const g = ui.chart.getContext('2d', CHART_CONTEXT);
     g.clearRect(0, 0, ui.chart.width, ui.chart.height);
     setFitState('idle');
   }
 
+  /** The line layer: fitted curve, control net, error vectors, iso lines, initial net. */
+  function lines() {
+    const parts = [];
+    const { limit, control } = frame;
+    if (limit.indices.length === 0) parts.push([edgeSegments(limit.positions, limit.edges), CURVE_COLOR]);
+    if (ui.cage.checked) parts.push([edgeSegments(control.positions, control.edges), CAGE_COLOR]);
+    if (ui.vectors.checked) parts.push([frame.vectors, VECTOR_COLOR]);
+    if (ui.iso.checked) parts.push([frame.iso, ISO_COLOR]);
+    if (ui.initialMesh.checked) parts.push([edgeSegments(once.initial.positions, once.initial.edges), INITIAL_COLOR]);
+    return lineSet(parts);
+  }
+
+  function drawPoints(viewer) {
+    const tolUnitsMax = ((tolerances.max ?? 0.05) * frame.stats.diagonal) / 100;
+    viewer.setPoints(once.data, errorColors(frame.errors, tolUnitsMax));
+  }
+
+  function drawSurface(viewer) {
+    const { limit } = frame;
+    if (limit.indices.length > 0) viewer.setMesh(limit.positions, limit.normals, limit.indices);
+    else viewer.setMesh(new Float32Array(), new Float32Array(), new Uint32Array());
+  }
+
+  function drawLines(viewer) {
+    const l = lines();
+    viewer.setLines(l.positions, l.colors);
+  }
+
+  /** Replaces the whole scene with the current frame's (after a toggle). */
   function redraw() {
     const viewer = host.viewer();
     if (!viewer || !frame) return;
-    const tolUnits = ((tolerances.max ?? 0.05) * frame.stats.diagonal) / 100;
-    viewer.setPoints(frame.data, errorColors(frame.errors, tolUnits));
-    viewer.setMesh(frame.limit.positions, frame.limit.normals, frame.limit.indices);
-    const lines = lineSet(frame, ui.cage.checked, ui.vectors.checked);
-    viewer.setLines(lines.positions, lines.colors);
+    drawPoints(viewer);
+    drawSurface(viewer);
+    drawLines(viewer);
     host.requestRender();
   }
 
@@ -253,46 +338,68 @@ export function createFitUi(host) {
     ui.eRms.textContent = `${fmtPct(s.eRmsPct)} (${fmtUnits(s.eRms)} units)`;
     ui.ms.textContent = `${s.ms.toFixed(1)} ms`;
     ui.total.textContent = `${(s.totalMs / 1000).toFixed(2)} s`;
-    const tolUnits = ((tolerances.max ?? 0.05) * s.diagonal) / 100;
-    ui.legendTol.textContent = `+${fmtUnits(tolUnits)}`;
-    ui.legendNeg.textContent = `−${fmtUnits(tolUnits)}`;
+    const tolUnitsMax = ((tolerances.max ?? 0.05) * s.diagonal) / 100;
+    ui.legendTol.textContent = `+${fmtUnits(tolUnitsMax)}`;
+    ui.legendNeg.textContent = `−${fmtUnits(tolUnitsMax)}`;
     document.body.dataset.fitIter = String(s.iter);
   }
 
-  /** Shows the newest frame: statistics, chart and scene (one animation frame, however many came). */
-  function applyFrame() {
+  // A frame is shown in stages, each its own task (figures, points, surface, lines), so that
+  // no main-thread task holds all of a frame's uploads; the picture is drawn at the next
+  // animation frame. Frames that arrive meanwhile are skipped but the newest one.
+  let showing = false;
+  const STAGES = [
+    (viewer, m) => {
+      if (m.once) once = m.once;
+      frame = m;
+      state.lastStats = m.stats;
+      state.history = m.history;
+      state.frames += 1;
+      showStats(m.stats);
+      drawChart(ui.chart, m.history, tolerances);
+    },
+    (viewer) => viewer && drawPoints(viewer),
+    (viewer) => viewer && drawSurface(viewer),
+    (viewer, m) => {
+      if (viewer) drawLines(viewer);
+      host.requestRender();
+      playing = m.playing;
+      const status = m.stats.status;
+      setFitState(status === 'running' ? (playing ? 'running' : 'paused') : status);
+    },
+  ];
+
+  /** Runs stage `k` of frame `m`, then the next one in a new task. */
+  function showStage(m, k) {
+    if (m.generation !== generation) {
+      showNewest();
+      return;
+    }
+    const t0 = performance.now();
+    STAGES[k](host.viewer(), m);
+    state.maxStageMs = Math.max(state.maxStageMs ?? 0, performance.now() - t0);
+    setTimeout(() => (k + 1 < STAGES.length ? showStage(m, k + 1) : showNewest()), 0);
+  }
+
+  function showNewest() {
     const m = pending;
     pending = null;
-    if (!m || m.generation !== generation) return;
-    const t0 = performance.now();
-    if (m.data) data = m.data;
-    frame = { ...m, data };
-    state.lastStats = m.stats;
-    state.history = m.history;
-    state.frames += 1;
-    showStats(m.stats);
-    drawChart(ui.chart, m.history, tolerances);
-    redraw();
-    playing = m.playing;
-    const status = m.stats.status;
-    setFitState(status === 'running' ? (playing ? 'running' : 'paused') : status);
-    state.maxFrameMs = Math.max(state.maxFrameMs, performance.now() - t0);
+    showing = Boolean(m);
+    if (m) showStage(m, 0);
   }
 
   worker.onmessage = ({ data: m }) => {
     if (m.type === 'frame') {
       if (m.generation !== generation) return;
-      // The data points come with a fit's first frame only; keep them if a newer frame overtakes it.
-      if (pending?.data && !m.data) m.data = pending.data;
-      if (!pending) requestAnimationFrame(applyFrame);
+      // What a fit's first frame carries once: keep it if a newer frame overtakes that one.
+      if (pending?.once && !m.once) m.once = pending.once;
       pending = m;
+      if (!showing) {
+        showing = true;
+        setTimeout(showNewest, 0);
+      }
     } else if (m.type === 'exported') {
-      const names = {
-        cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
-        ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
-        json: ['geofit-report.json', 'application/json'],
-      }[m.what];
-      download(m.bytes, ...names);
+      download(m.bytes, ...EXPORTS[m.what]);
     } else if (m.type === 'error') {
       if (m.generation !== generation) return;
       host.showError(`Fit (${m.during}): ${m.message}`);
@@ -322,12 +429,13 @@ export function createFitUi(host) {
     worker.postMessage({ type: 'step' });
   });
   ui.reset.addEventListener('click', restart);
-  for (const input of [ui.scheme, ui.tolAvg, ui.tolMax, ui.initial, ui.maxIter, ui.refine,
-    ui.maxControl, ui.weights, ui.accel]) {
+  ui.scheme.addEventListener('change', schemeChanged);
+  for (const input of [ui.scheme, ui.method, ui.closed, ui.tolAvg, ui.tolMax, ui.tolAvgUnits, ui.tolMaxUnits,
+    ui.initial, ui.maxIter, ui.refine, ui.maxControl, ui.weights, ui.accel]) {
     input.addEventListener('change', () => built && restart());
   }
   ui.refine.addEventListener('change', () => { ui.maxControl.disabled = !ui.refine.checked; });
-  for (const box of [ui.cage, ui.vectors]) box.addEventListener('change', redraw);
+  for (const box of [ui.cage, ui.vectors, ui.iso, ui.initialMesh]) box.addEventListener('change', redraw);
   for (const button of document.querySelectorAll('[data-export]')) {
     button.addEventListener('click', () => worker.postMessage({ type: 'export', what: button.dataset.export }));
   }
@@ -341,11 +449,17 @@ export function createFitUi(host) {
     }, 'image/png');
   });
   new ResizeObserver(() => state.history.length && drawChart(ui.chart, state.history, tolerances)).observe(ui.chart);
+  schemeChanged();
   setFitState('idle');
 
   return {
-    onScan(bytes, name) {
-      scan = { bytes, name };
+    onScan(bytes, name, diagonal, preset = {}) {
+      scan = { bytes, name, diagonal };
+      if (preset.scheme) ui.scheme.value = preset.scheme;
+      if (preset.closed !== undefined) ui.closed.checked = preset.closed;
+      if (preset.tolMax !== undefined) ui.tolMax.value = String(preset.tolMax);
+      schemeChanged();
+      for (const update of tolUnits) update();
       clear();
     },
   };

@@ -4,7 +4,12 @@
 import init, { Viewer, loadFile } from '../pkg/geofit.js';
 import { createFitUi } from './fit-ui.js';
 
-const DEFAULT_SAMPLE = 'samples/bunny.obj';
+// Bundled samples (www/samples/) and the fit settings that suit each.
+const SAMPLE_PRESETS = {
+  'bunny.obj': { scheme: 'loop', tolMax: 0.5 },
+  'bun000-points.xyz': { scheme: 'bspline-surface', tolMax: 0.5 },
+  'bunny-section.xyz': { scheme: 'bspline-curve', closed: true, tolMax: 0.1 },
+};
 // Height colours, low to high (sRGB): blue, teal, amber.
 const PALETTE = [
   [0.15, 0.35, 0.95],
@@ -24,6 +29,8 @@ const ui = {
   showPoints: el('show-points'),
   showMesh: el('show-mesh'),
   showWireframe: el('show-wireframe'),
+  showZebra: el('show-zebra'),
+  sample: el('sample'),
 };
 
 let viewer = null;
@@ -78,6 +85,12 @@ function heightColors(positions) {
   return colors;
 }
 
+/** The bounding-box diagonal of a loaded scan (model units). */
+function diagonal(scan) {
+  const [lo, hi] = [scan.bboxMin(), scan.bboxMax()];
+  return lo.length === 3 ? Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) : 0;
+}
+
 /** Parses `bytes` with the Rust readers and shows the result; on error keeps what was shown. */
 function show(bytes, name) {
   let scan;
@@ -96,6 +109,7 @@ function show(bytes, name) {
     if (viewer) {
       viewer.setPoints(positions, heightColors(positions));
       viewer.setMesh(meshPositions, normals, indices);
+      viewer.setLines(new Float32Array(), new Float32Array());
       viewer.fitView();
     }
     ui.fileName.textContent = name;
@@ -104,7 +118,7 @@ function show(bytes, name) {
     clearError();
     setState('ready');
     requestRender();
-    fitUi?.onScan(bytes, name, positions);
+    fitUi?.onScan(bytes, name, diagonal(scan), SAMPLE_PRESETS[name]);
     return true;
   } catch (e) {
     showError(`Could not show ${name}: ${e?.message ?? e}`);
@@ -121,6 +135,7 @@ async function openFile(file) {
 }
 
 function updateLayers() {
+  viewer?.setZebra(ui.showZebra.checked);
   viewer?.setLayers(
     ui.showPoints.checked,
     ui.showMesh.checked,
@@ -214,7 +229,7 @@ async function main() {
   bindFiles();
   bindCamera();
   fitUi = createFitUi({ viewer: () => viewer, requestRender, showError, canvas: ui.canvas });
-  for (const box of [ui.showPoints, ui.showMesh, ui.showWireframe]) {
+  for (const box of [ui.showPoints, ui.showMesh, ui.showWireframe, ui.showZebra]) {
     box.addEventListener('change', updateLayers);
   }
   const ratio = window.devicePixelRatio || 1;
@@ -234,13 +249,19 @@ async function main() {
   window.addEventListener('resize', resize);
   resize();
   updateLayers();
-  const response = await fetch(DEFAULT_SAMPLE);
+  ui.sample.addEventListener('change', () => openSample(ui.sample.value));
+  await openSample(ui.sample.value);
+}
+
+/** Fetches a bundled sample from www/samples/ and shows it. */
+async function openSample(name) {
+  const response = await fetch(`samples/${name}`);
   if (!response.ok) {
-    showError(`Could not fetch the sample ${DEFAULT_SAMPLE}: HTTP ${response.status}`);
+    showError(`Could not fetch the sample ${name}: HTTP ${response.status}`);
     setState('error');
     return;
   }
-  show(new Uint8Array(await response.arrayBuffer()), DEFAULT_SAMPLE.split('/').pop());
+  show(new Uint8Array(await response.arrayBuffer()), name);
 }
 
 main().catch((e) => {

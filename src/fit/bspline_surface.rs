@@ -181,6 +181,11 @@ impl GeometricSurfaceFitter {
         self.num_folded
     }
 
+    /// The foot-point parameters (u, v) of every data point, in data order.
+    pub fn parameters(&self) -> &[[f64; 2]] {
+        &self.uv
+    }
+
     /// Control points at the start.
     pub fn initial_control_points(&self) -> usize {
         self.initial_control

@@ -20,6 +20,9 @@ pub struct Uniforms {
     pub mesh_color: [f32; 4],
     /// Wireframe colour, sRGB (a unused).
     pub wire_color: [f32; 4],
+    /// x: 1 to shade the mesh with zebra stripes (reflection lines) instead of the clay
+    /// (y, z, w unused).
+    pub shading: [f32; 4],
 }
 
 impl Uniforms {

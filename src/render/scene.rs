@@ -118,8 +118,12 @@ pub struct Renderer {
     mesh: Vec3Pair,
     triangles: Indices,
     edges: Indices,
+    /// The triangle indices whose wireframe edges are not built yet: edges are made only when
+    /// the wireframe is drawn, so that replacing the mesh every frame (a running fit) stays cheap.
+    stale_edges: Option<Vec<u32>>,
     lines: Vec3Pair,
     layers: Layers,
+    zebra: bool,
     /// Bounding boxes of the points, the mesh and the lines, for fitting the view.
     bounds: [Option<(Vec3, Vec3)>; 3],
     point_size: f32,
@@ -158,6 +162,7 @@ impl Renderer {
             mesh: Vec3Pair::new(device),
             triangles: index_buffer(),
             edges: index_buffer(),
+            stale_edges: None,
             lines: Vec3Pair::new(device),
             layers: Layers {
                 points: true,
@@ -165,6 +170,7 @@ impl Renderer {
                 wireframe: false,
                 lines: true,
             },
+            zebra: false,
             bounds: [None; 3],
             point_size: DEFAULT_POINT_SIZE,
             pixel_ratio: 1.0,
@@ -205,8 +211,7 @@ impl Renderer {
         check_indices("triangle indices", indices, 3, positions.len() / 3)?;
         self.mesh.write(&self.gpu, positions, normals);
         self.triangles.write(&self.gpu, indices);
-        let edges = super::buffers::triangle_edges(indices);
-        self.edges.write(&self.gpu, &edges);
+        self.stale_edges = Some(indices.to_vec());
         self.bounds[1] = xyz_bounds(positions);
         Ok(())
     }
@@ -237,6 +242,11 @@ impl Renderer {
             wireframe,
             lines,
         };
+    }
+
+    /// Shades the mesh with zebra stripes (reflection lines) instead of the clay colour.
+    pub fn set_zebra(&mut self, on: bool) {
+        self.zebra = on;
     }
 
     /// Point diameter in CSS pixels (scaled by the device pixel ratio when drawn).
@@ -290,6 +300,12 @@ impl Renderer {
             _ => return,
         };
         self.write_uniforms();
+        if self.layers.wireframe {
+            if let Some(indices) = self.stale_edges.take() {
+                let edges = super::buffers::triangle_edges(&indices);
+                self.edges.write(&self.gpu, &edges);
+            }
+        }
         let view = frame.texture.create_view(&Default::default());
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
@@ -385,6 +401,7 @@ impl Renderer {
             ],
             mesh_color: MESH_COLOR,
             wire_color: WIRE_COLOR,
+            shading: [if self.zebra { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
         };
         self.gpu
             .queue

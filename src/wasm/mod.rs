@@ -2,6 +2,7 @@
 //! Names are camelCase on the JavaScript side; bulk data crosses as typed arrays; every error
 //! reaches JavaScript as a thrown `Error` carrying the Rust error's message.
 
+mod engine;
 mod fitter;
 mod scan;
 mod viewer;

@@ -54,6 +54,13 @@ impl Viewer {
         self.renderer.set_layers(points, mesh, wireframe, lines);
     }
 
+    /// Shades the mesh with zebra stripes (reflection lines, to judge fairness) when `on`,
+    /// else with the lit clay colour.
+    #[wasm_bindgen(js_name = setZebra)]
+    pub fn set_zebra(&mut self, on: bool) {
+        self.renderer.set_zebra(on);
+    }
+
     /// Point diameter in CSS pixels.
     #[wasm_bindgen(js_name = setPointSize)]
     pub fn set_point_size(&mut self, css_pixels: f32) {

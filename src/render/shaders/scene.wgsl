@@ -12,6 +12,8 @@ struct Uniforms {
     mesh_color: vec4<f32>,
     // rgb: the wireframe colour (sRGB).
     wire_color: vec4<f32>,
+    // x: 1 for zebra stripes on the mesh.
+    shading: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> u: Uniforms;
@@ -91,12 +93,29 @@ fn vs_mesh(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> 
     return out;
 }
 
+// Stripes per half turn of the reflected view direction's elevation.
+const ZEBRA_STRIPES: f32 = 9.0;
+
+// Zebra stripes: the view direction reflected in the surface, black and white by its elevation
+// (reflection lines of a striped sky). Kinks and wobbles in the stripes show where the surface
+// is not smooth or not fair.
+fn zebra(n: vec3<f32>, l: vec3<f32>, d: f32) -> vec3<f32> {
+    let facing = select(-n, n, dot(n, l) >= 0.0);
+    let r = reflect(-l, facing);
+    let t = asin(clamp(r.y, -1.0, 1.0)) / 3.14159265 * ZEBRA_STRIPES;
+    let stripe = select(0.04, 0.85, fract(t) < 0.5);
+    return vec3(stripe * (0.35 + 0.65 * d));
+}
+
 // A headlight: diffuse plus a little specular, two-sided because scans are open surfaces.
 @fragment
 fn fs_mesh(in: MeshOut) -> @location(0) vec4<f32> {
     let n = normalize(in.normal);
     let l = normalize(u.eye.xyz - in.world);
     let d = abs(dot(n, l));
+    if u.shading.x > 0.5 {
+        return output(zebra(n, l, d));
+    }
     let base = srgb_to_linear(u.mesh_color.rgb);
     let lit = base * (0.15 + 0.85 * d) + vec3(0.25 * pow(d, 40.0));
     return output(lit);
