@@ -12,15 +12,22 @@ use crate::subdiv::{quadrangulate, refine, Scheme, SubdivSurface};
 /// The limit surface of `control` under `scheme`; quad schemes accept any polygon mesh and turn
 /// it into quads first (one Catmull–Clark step) when it is not all quads.
 pub fn surface_of(scheme: Scheme, control: &PolyMesh) -> Result<SubdivSurface, FitError> {
+    Ok(SubdivSurface::try_new(
+        scheme,
+        control_mesh_of(scheme, control)?,
+    )?)
+}
+
+/// The control mesh of `control` for `scheme` (quads for the quad schemes).
+fn control_mesh_of(scheme: Scheme, control: &PolyMesh) -> Result<ControlMesh, FitError> {
     let mesh = ControlMesh::try_new(control).map_err(|e| FitError::ControlMesh {
         reason: e.to_string(),
     })?;
-    let mesh = match scheme {
+    Ok(match scheme {
         Scheme::Loop => mesh,
         _ if mesh.is_quad_mesh() => mesh,
         _ => quadrangulate(&mesh)?,
-    };
-    Ok(SubdivSurface::try_new(scheme, mesh)?)
+    })
 }
 
 impl ControlSurface for SubdivSurface {
@@ -37,7 +44,7 @@ impl ControlSurface for SubdivSurface {
     }
 
     fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError> {
-        surface_of(self.scheme(), control)
+        Ok(self.with_mesh(control_mesh_of(self.scheme(), control)?)?)
     }
 
     /// Loop and Catmull–Clark patches are the control faces. Doo–Sabin patches sit at

@@ -1,7 +1,12 @@
 //! Closed-form bases of regular patches: the quartic three-direction box spline (Loop) and the
-//! uniform bicubic B-spline (Catmull–Clark), with first and second derivatives.
+//! uniform bicubic B-spline (Catmull–Clark), and their power forms used for evaluation. The
+//! basis-function forms are kept for tests that check the power forms against them.
+
+use super::LimitEval;
+use crate::geom::Vec3;
 
 /// Basis weights at one parameter: value, ∂u, ∂v, ∂uu, ∂uv, ∂vv for each control point.
+#[cfg(test)]
 pub(crate) type Weights<const N: usize> = [[f64; N]; 6];
 
 /// Lattice positions of the 12 control points of a regular Loop patch whose corners are at
@@ -77,6 +82,7 @@ fn powers(x: f64) -> [[f64; 5]; 3] {
 }
 
 /// Box-spline weights of the 12 points of [`LOOP_LATTICE`] at (u, v).
+#[cfg(test)]
 pub(crate) fn loop_box(u: f64, v: f64) -> Weights<12> {
     let (pu, pv) = (powers(u), powers(v));
     // (du order, dv order) of value, ∂u, ∂v, ∂uu, ∂uv, ∂vv.
@@ -98,6 +104,7 @@ pub(crate) fn loop_box(u: f64, v: f64) -> Weights<12> {
 }
 
 /// Uniform cubic B-spline basis on [0, 1] (value, first, second derivative).
+#[cfg(test)]
 fn cubic(t: f64) -> [[f64; 4]; 3] {
     let s = 1.0 - t;
     [
@@ -130,6 +137,7 @@ pub(crate) fn bicubic_lattice() -> [(i32, i32); 16] {
 }
 
 /// Bicubic B-spline weights of the 16 points of [`bicubic_lattice`] at (u, v).
+#[cfg(test)]
 pub(crate) fn bicubic(u: f64, v: f64) -> Weights<16> {
     let (bu, bv) = (cubic(u), cubic(v));
     const ORDERS: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
@@ -145,6 +153,7 @@ pub(crate) fn bicubic(u: f64, v: f64) -> Weights<16> {
 }
 
 /// Uniform quadratic B-spline basis on [0, 1] (value, first, second derivative).
+#[cfg(test)]
 fn quadratic(t: f64) -> [[f64; 3]; 3] {
     let s = 1.0 - t;
     [
@@ -161,6 +170,7 @@ fn quadratic(t: f64) -> [[f64; 3]; 3] {
 /// Biquadratic B-spline weights of the 3 × 3 points (i, j) ∈ {-1, 0, 1}², index
 /// `3 (j + 1) + (i + 1)`, at (u, v): the regular Doo–Sabin patch of the middle point, whose
 /// corners are the centroids of its four faces.
+#[cfg(test)]
 pub(crate) fn biquadratic(u: f64, v: f64) -> Weights<9> {
     let (bu, bv) = (quadratic(u), quadratic(v));
     const ORDERS: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
@@ -173,6 +183,128 @@ pub(crate) fn biquadratic(u: f64, v: f64) -> Weights<9> {
         }
     }
     w
+}
+
+/// A scheme's regular-patch basis rewritten in powers u^a v^b: patches are evaluated from
+/// per-patch power coefficients (computed once per control-point update), so one evaluation
+/// with first and second derivatives is a few multiply-adds per monomial instead of expanding
+/// every basis function.
+#[derive(Clone)]
+pub(crate) struct PowerBasis {
+    /// Exponents (a, b) of each monomial.
+    pub exps: Vec<(usize, usize)>,
+    /// Number of spline control points (12 box-spline, 16 bicubic, 9 biquadratic).
+    pub points: usize,
+    /// `exps.len() × points`, row-major: power coefficients from spline control points.
+    pub to_power: Vec<f64>,
+}
+
+/// Power coefficients of the uniform cubic B-spline basis on [0, 1] (rows: basis functions).
+const CUBIC_POWER: [[f64; 4]; 4] = [
+    [1.0 / 6.0, -0.5, 0.5, -1.0 / 6.0],
+    [4.0 / 6.0, 0.0, -1.0, 0.5],
+    [1.0 / 6.0, 0.5, 0.5, -0.5],
+    [0.0, 0.0, 0.0, 1.0 / 6.0],
+];
+
+/// Power coefficients of the uniform quadratic B-spline basis on [0, 1].
+const QUADRATIC_POWER: [[f64; 3]; 3] = [[0.5, -1.0, 0.5], [0.5, 1.0, -1.0], [0.0, 0.0, 0.5]];
+
+impl PowerBasis {
+    /// The power form of the box spline (`triangle`) or of a tensor-product B-spline of the
+    /// given degree (3: Catmull–Clark, 2: Doo–Sabin).
+    pub fn new(triangle: bool, degree: usize) -> PowerBasis {
+        if triangle {
+            let exps: Vec<(usize, usize)> = MONOMIALS
+                .iter()
+                .map(|&(a, b)| (a as usize, b as usize))
+                .collect();
+            let mut to_power = vec![0.0; exps.len() * 12];
+            for (i, coeffs) in LOOP_BOX.iter().enumerate() {
+                for (m, c) in coeffs.iter().enumerate() {
+                    to_power[m * 12 + i] = c / 12.0;
+                }
+            }
+            return PowerBasis {
+                exps,
+                points: 12,
+                to_power,
+            };
+        }
+        let n = degree + 1;
+        let coeff = |i: usize, a: usize| {
+            if degree == 3 {
+                CUBIC_POWER[i][a]
+            } else {
+                QUADRATIC_POWER[i][a]
+            }
+        };
+        let mut exps = Vec::with_capacity(n * n);
+        let mut to_power = vec![0.0; n * n * n * n];
+        for b in 0..n {
+            for a in 0..n {
+                let m = exps.len();
+                exps.push((a, b));
+                for j in 0..n {
+                    for i in 0..n {
+                        to_power[m * n * n + n * j + i] = coeff(i, a) * coeff(j, b);
+                    }
+                }
+            }
+        }
+        PowerBasis {
+            exps,
+            points: n * n,
+            to_power,
+        }
+    }
+
+    /// Number of monomials.
+    pub fn len(&self) -> usize {
+        self.exps.len()
+    }
+
+    /// Power coefficients of the patch whose spline control points are `cp`, appended to `out`.
+    pub fn coefficients(&self, cp: &[Vec3], out: &mut Vec<Vec3>) {
+        for row in self.to_power.chunks_exact(self.points) {
+            out.push(row.iter().zip(cp).map(|(&w, &p)| p * w).sum());
+        }
+    }
+
+    /// Limit point and derivatives at (u, v) from power coefficients.
+    pub fn eval(&self, coeffs: &[Vec3], u: f64, v: f64) -> LimitEval {
+        let (pu, pv) = (powers(u), powers(v));
+        let mut e = LimitEval::default();
+        for (&(a, b), &c) in self.exps.iter().zip(coeffs) {
+            e.point += c * (pu[0][a] * pv[0][b]);
+            e.du += c * (pu[1][a] * pv[0][b]);
+            e.dv += c * (pu[0][a] * pv[1][b]);
+            e.duu += c * (pu[2][a] * pv[0][b]);
+            e.duv += c * (pu[1][a] * pv[1][b]);
+            e.dvv += c * (pu[0][a] * pv[2][b]);
+        }
+        e
+    }
+
+    /// Values of the monomials at (u, v), into `out` (length [`PowerBasis::len`]).
+    pub fn values(&self, u: f64, v: f64, out: &mut [f64]) {
+        let (pu, pv) = (powers(u), powers(v));
+        for (o, &(a, b)) in out.iter_mut().zip(&self.exps) {
+            *o = pu[0][a] * pv[0][b];
+        }
+    }
+
+    /// Weights of the spline control points for the position at (u, v), into `out`.
+    pub fn point_weights(&self, u: f64, v: f64, out: &mut [f64]) {
+        let mut vals = [0.0; 16];
+        self.values(u, v, &mut vals);
+        out[..self.points].fill(0.0);
+        for (row, &m) in self.to_power.chunks_exact(self.points).zip(&vals) {
+            for (o, &w) in out.iter_mut().zip(row) {
+                *o += m * w;
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -207,5 +339,48 @@ mod tests {
             .map(|(p, w)| p.1 as f64 * w)
             .sum();
         assert!((x - u).abs() < 1e-14 && (y - v).abs() < 1e-14);
+    }
+
+    #[test]
+    fn power_forms_match_the_bases() {
+        let pts: Vec<Vec3> = (0..16)
+            .map(|i| Vec3::new(i as f64, (i * i) as f64 * 0.1, (i as f64).sin()))
+            .collect();
+        for &(u, v) in &[(0.0, 0.0), (0.2, 0.3), (0.5, 0.25), (0.9, 0.05)] {
+            let cases: [(PowerBasis, Vec<[f64; 16]>); 3] = [
+                (PowerBasis::new(true, 4), pad(&loop_box(u, v))),
+                (PowerBasis::new(false, 3), pad(&bicubic(u, v))),
+                (PowerBasis::new(false, 2), pad(&biquadratic(u, v))),
+            ];
+            for (basis, weights) in cases {
+                let mut coeffs = Vec::new();
+                basis.coefficients(&pts[..basis.points], &mut coeffs);
+                let e = basis.eval(&coeffs, u, v);
+                let got = [e.point, e.du, e.dv, e.duu, e.duv, e.dvv];
+                for (d, w) in weights.iter().enumerate() {
+                    let want: Vec3 = w.iter().zip(&pts).map(|(&w, &p)| p * w).sum();
+                    assert!(
+                        (got[d] - want).length() < 1e-12,
+                        "{d}: {} vs {want}",
+                        got[d]
+                    );
+                }
+                let mut pw = [0.0; 16];
+                basis.point_weights(u, v, &mut pw);
+                for i in 0..basis.points {
+                    assert!((pw[i] - weights[0][i]).abs() < 1e-14);
+                }
+            }
+        }
+    }
+
+    fn pad<const N: usize>(w: &Weights<N>) -> Vec<[f64; 16]> {
+        w.iter()
+            .map(|row| {
+                let mut out = [0.0; 16];
+                out[..N].copy_from_slice(row);
+                out
+            })
+            .collect()
     }
 }

@@ -12,7 +12,7 @@
 //! share one node, and the sub-patch at an extraordinary vertex maps to itself after the first
 //! step (a self-loop in the graph), as in Stam's eigen-analysis but without eigenvectors.
 
-use super::basis::{bicubic, bicubic_lattice, biquadratic, loop_box, LOOP_LATTICE};
+use super::basis::{bicubic_lattice, PowerBasis, LOOP_LATTICE};
 use super::topo::{key, EdgeTag, Stencil, Topo, NO};
 use super::{LimitEval, Scheme, SubdivError};
 use crate::geom::{Point3, Vec3};
@@ -25,6 +25,9 @@ pub(crate) const MAX_LOCAL: usize = 64;
 const MAX_DEPTH: usize = 40;
 /// Extra levels allowed after moving to the sub-patch centre at [`MAX_DEPTH`].
 const EXTRA_DEPTH: usize = 24;
+/// Levels of local subdivision flattened into a [`Shortcut`]: a sample goes deeper with
+/// probability about 4^-depth, so almost every evaluation is one polynomial.
+const SHORTCUT_DEPTH: usize = 2;
 
 /// Affine map from a parent patch's parameters into a child's: `child = m · (p − origin)`.
 #[derive(Clone, Copy, Debug)]
@@ -58,6 +61,7 @@ impl ChildMap {
 
 /// A sparse matrix (rows of weights over local points): subdivision stencils have a handful
 /// of non-zeros per row, so evaluation cost follows the stencil sizes, not `k²`.
+#[derive(Clone)]
 struct Sparse {
     starts: Vec<u32>,
     cols: Vec<u16>,
@@ -114,6 +118,7 @@ impl Sparse {
     }
 }
 
+#[derive(Clone)]
 struct Child {
     node: u32,
     k: usize,
@@ -122,6 +127,7 @@ struct Child {
     map: ChildMap,
 }
 
+#[derive(Clone)]
 enum Node {
     /// Placeholder while the node is being built.
     Pending,
@@ -136,30 +142,112 @@ enum Node {
 }
 
 /// The interned patch shapes of one surface.
+#[derive(Clone)]
 pub(crate) struct Graph {
     scheme: Scheme,
     nodes: Vec<Node>,
     index: HashMap<Vec<u32>, u32>,
     pending: Vec<(u32, Topo, Kind)>,
+    /// The scheme's regular patch in power form.
+    power: PowerBasis,
+    shortcuts: Vec<Shortcut>,
+    shortcut_of: HashMap<u32, u32>,
 }
 
-/// A canonical neighbourhood of one face: local topology and where each local point came from.
+/// The first [`SHORTCUT_DEPTH`] levels of a patch shape's descent, with every regular leaf's
+/// power coefficients and every deeper sub-patch's points written as one dense matrix over the
+/// patch's local points. A surface multiplies these by its control points once per update
+/// ([`Graph::fill_shortcut`]); evaluation then walks a few cells and evaluates one polynomial
+/// instead of subdividing per sample.
+#[derive(Clone)]
+struct Shortcut {
+    cells: Vec<Cell>,
+    /// Local points of the root.
+    k: usize,
+    /// Length of a patch's cached data (sum of the cells' lengths).
+    len: usize,
+}
+
+#[derive(Clone)]
+enum Cell {
+    /// Descend into the child cell holding the parameter.
+    Split { children: Vec<(u32, ChildMap)> },
+    /// A regular sub-patch: `mat` (monomials × k) gives its power coefficients.
+    Leaf { offset: usize, mat: Vec<f64> },
+    /// A sub-patch at the shortcut's depth that needs more subdivision: `mat` (`kd × k`) gives
+    /// its local points, and [`Graph::eval`] continues from `node`.
+    Deep {
+        offset: usize,
+        node: u32,
+        kd: usize,
+        mat: Vec<f64>,
+    },
+}
+
+/// Dense `rows × k` product of a sparse `rows × m` matrix and a dense `m × k` one.
+fn sparse_times_dense(a: &Sparse, b: &[f64], k: usize) -> Vec<f64> {
+    let mut out = vec![0.0; a.rows() * k];
+    for r in 0..a.rows() {
+        let row = &mut out[r * k..(r + 1) * k];
+        for (j, w) in a.row(r) {
+            for (o, &x) in row.iter_mut().zip(&b[j * k..(j + 1) * k]) {
+                *o += w * x;
+            }
+        }
+    }
+    out
+}
+
+/// `out.push(Σ_j mat[r][j] pts[j])` for every row of the row-major `mat` (`pts.len()` columns).
+fn apply_dense(mat: &[f64], pts: &[Point3], out: &mut Vec<Vec3>) {
+    for row in mat.chunks_exact(pts.len().max(1)) {
+        out.push(row.iter().zip(pts).map(|(&w, &p)| p * w).sum());
+    }
+}
+
+/// A canonical neighbourhood of one face: local faces and where each local point came from.
+/// Its [`Topo`] is only built when the shape is new to the graph ([`Neighbourhood::topo`]).
 pub(crate) struct Neighbourhood {
-    pub topo: Topo,
     pub source: Vec<u32>,
+    starts: Vec<u32>,
+    verts: Vec<u32>,
+    /// Tags of the local edges in order of first appearance (the order of [`Topo::new`]).
+    tags: Vec<EdgeTag>,
     key: Vec<u32>,
     kind: Kind,
+}
+
+impl Neighbourhood {
+    /// Number of local points.
+    fn len(&self) -> usize {
+        self.source.len()
+    }
+
+    fn topo(self) -> (Topo, Kind) {
+        let mut tags = self.tags.into_iter();
+        let topo = Topo::new(self.source.len(), self.starts, self.verts, |_, _| {
+            tags.next().unwrap_or_default()
+        });
+        (topo, self.kind)
+    }
+}
+
+/// The local index of `v`, appending it to `source` if new (neighbourhoods are small, so a
+/// linear scan beats hashing).
+fn local_index(source: &mut Vec<u32>, v: u32) -> u32 {
+    match source.iter().position(|&x| x == v) {
+        Some(i) => i as u32,
+        None => {
+            source.push(v);
+            (source.len() - 1) as u32
+        }
+    }
 }
 
 /// Gathers the faces around every corner of `f` in a canonical order: corners first, then the
 /// fans of the corners in turn (counter-clockwise from `f`, then clockwise).
 pub(crate) fn neighbourhood(src: &Topo, f: u32) -> Neighbourhood {
     let mut source: Vec<u32> = src.face(f).to_vec();
-    let mut local: HashMap<u32, u32> = source
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| (v, i as u32))
-        .collect();
     let mut faces = vec![f];
     let mut fan = Vec::new();
     for &c in src.face(f) {
@@ -173,15 +261,11 @@ pub(crate) fn neighbourhood(src: &Topo, f: u32) -> Neighbourhood {
             let gv = src.face(g);
             let start = gv.iter().position(|&x| x == c).unwrap_or(0);
             for i in 0..gv.len() {
-                let v = gv[(start + i) % gv.len()];
-                local.entry(v).or_insert_with(|| {
-                    source.push(v);
-                    (source.len() - 1) as u32
-                });
+                local_index(&mut source, gv[(start + i) % gv.len()]);
             }
         }
     }
-    finish(src, source, &local, &faces, Kind::Face)
+    finish(src, source, &faces, Kind::Face)
 }
 
 /// What a neighbourhood is the neighbourhood of: a face (Loop, Catmull–Clark patches), a
@@ -197,65 +281,66 @@ pub(crate) enum Kind {
 /// Gathers the faces around vertex `v` counter-clockwise from `f` (local vertex 0 is `v`).
 pub(crate) fn vertex_neighbourhood(src: &Topo, v: u32, f: u32, kind: Kind) -> Neighbourhood {
     let mut source = vec![v];
-    let mut local: HashMap<u32, u32> = HashMap::from([(v, 0)]);
     let mut faces = Vec::new();
     src.fan(v, f, false, &mut faces);
     for &g in &faces {
         let gv = src.face(g);
         let start = gv.iter().position(|&x| x == v).unwrap_or(0);
         for i in 0..gv.len() {
-            let w = gv[(start + i) % gv.len()];
-            local.entry(w).or_insert_with(|| {
-                source.push(w);
-                (source.len() - 1) as u32
-            });
+            local_index(&mut source, gv[(start + i) % gv.len()]);
         }
     }
-    finish(src, source, &local, &faces, kind)
+    finish(src, source, &faces, kind)
 }
 
-/// Builds the local topology of `faces` (face 0 rotated to start at local vertex 0, the others
-/// at their smallest local index) and the key that identifies its shape.
-fn finish(
-    src: &Topo,
-    source: Vec<u32>,
-    local: &HashMap<u32, u32>,
-    faces: &[u32],
-    kind: Kind,
-) -> Neighbourhood {
+/// Lays out the local faces of `faces` (face 0 rotated to start at local vertex 0, the others
+/// at their smallest local index) with their edge tags, and the key that identifies the shape.
+fn finish(src: &Topo, source: Vec<u32>, faces: &[u32], kind: Kind) -> Neighbourhood {
     let mut starts = vec![0u32];
     let mut verts = Vec::new();
-    let mut tags: HashMap<(u32, u32), EdgeTag> = HashMap::new();
     let mut key_out = vec![kind as u32, source.len() as u32, faces.len() as u32];
+    let mut gv = Vec::new();
+    let mut gt = Vec::new();
+    let mut edges: Vec<(u32, u32)> = Vec::new();
+    let mut tags: Vec<EdgeTag> = Vec::new();
     for (n, &g) in faces.iter().enumerate() {
-        let gv: Vec<u32> = src.face(g).iter().map(|v| local[v]).collect();
+        gv.clear();
+        gv.extend(
+            src.face(g)
+                .iter()
+                .map(|v| source.iter().position(|x| x == v).unwrap_or(0) as u32),
+        );
+        let ids = &src.face_edges
+            [src.face_starts[g as usize] as usize..src.face_starts[g as usize + 1] as usize];
+        gt.clear();
+        gt.extend(ids.iter().map(|&e| src.edge_tags[e as usize]));
         let rot = if n == 0 {
             gv.iter().position(|&x| x == 0).unwrap_or(0)
         } else {
             (0..gv.len()).min_by_key(|&i| gv[i]).unwrap_or(0)
         };
-        let ids = &src.face_edges
-            [src.face_starts[g as usize] as usize..src.face_starts[g as usize + 1] as usize];
-        for i in 0..gv.len() {
-            let (a, b) = (gv[i], gv[(i + 1) % gv.len()]);
-            tags.insert(key(a, b), src.edge_tags[ids[i] as usize]);
-        }
         key_out.push(gv.len() as u32);
         for i in 0..gv.len() {
-            verts.push(gv[(rot + i) % gv.len()]);
-            key_out.push(gv[(rot + i) % gv.len()]);
+            let r = (rot + i) % gv.len();
+            let (a, b) = (gv[r], gv[(r + 1) % gv.len()]);
+            verts.push(a);
+            key_out.push(a);
+            if !edges.contains(&key(a, b)) {
+                edges.push(key(a, b));
+                tags.push(gt[r]);
+            }
         }
         starts.push(verts.len() as u32);
     }
-    let topo = Topo::new(source.len(), starts, verts, |a, b| {
-        tags.get(&(a, b)).copied().unwrap_or_default()
-    });
-    for t in &topo.edge_tags {
-        key_out.push(u32::from(t.sharp) | (u32::from(t.open) << 1));
-    }
+    key_out.extend(
+        tags.iter()
+            .map(|t| u32::from(t.sharp) | (u32::from(t.open) << 1)),
+    );
     Neighbourhood {
-        topo,
         source,
+        starts,
+        verts,
+        tags,
         key: key_out,
         kind,
     }
@@ -515,11 +600,189 @@ fn doo_sabin_gather(topo: &Topo) -> Option<Vec<f64>> {
 
 impl Graph {
     pub fn new(scheme: Scheme) -> Graph {
+        let power = match scheme {
+            Scheme::Loop => PowerBasis::new(true, 4),
+            Scheme::CatmullClark => PowerBasis::new(false, 3),
+            Scheme::DooSabin => PowerBasis::new(false, 2),
+        };
         Graph {
             scheme,
             nodes: Vec::new(),
             index: HashMap::new(),
             pending: Vec::new(),
+            power,
+            shortcuts: Vec::new(),
+            shortcut_of: HashMap::new(),
+        }
+    }
+
+    /// The scheme's regular patch in power form.
+    pub fn power(&self) -> &PowerBasis {
+        &self.power
+    }
+
+    /// The shortcut of the patch shape `node` (built on first request) and the length of a
+    /// patch's cached data for it.
+    pub fn shortcut(&mut self, node: u32) -> (u32, usize) {
+        if let Some(&id) = self.shortcut_of.get(&node) {
+            return (id, self.shortcuts[id as usize].len);
+        }
+        let k = match &self.nodes[node as usize] {
+            Node::Regular { k, .. } | Node::Split { k, .. } => *k,
+            Node::Pending => 0,
+        };
+        let mut identity = vec![0.0; k * k];
+        for i in 0..k {
+            identity[i * k + i] = 1.0;
+        }
+        let mut cells = Vec::new();
+        self.shortcut_cell(node, 0, identity, k, &mut cells);
+        let mut len = 0;
+        for cell in &mut cells {
+            match cell {
+                Cell::Leaf { offset, .. } => {
+                    *offset = len;
+                    len += self.power.len();
+                }
+                Cell::Deep { offset, kd, .. } => {
+                    *offset = len;
+                    len += *kd;
+                }
+                Cell::Split { .. } => {}
+            }
+        }
+        let id = self.shortcuts.len() as u32;
+        self.shortcuts.push(Shortcut { cells, k, len });
+        self.shortcut_of.insert(node, id);
+        (id, len)
+    }
+
+    /// Appends the cell of `node` at `depth`, whose local points are `acc` (`k_node × k`) times
+    /// the root's, and its descendants; returns its index.
+    fn shortcut_cell(
+        &self,
+        node: u32,
+        depth: usize,
+        acc: Vec<f64>,
+        k: usize,
+        cells: &mut Vec<Cell>,
+    ) -> u32 {
+        let id = cells.len() as u32;
+        match &self.nodes[node as usize] {
+            Node::Regular { gather, .. } => {
+                let cp = sparse_times_dense(gather, &acc, k);
+                let mut mat = vec![0.0; self.power.len() * k];
+                let rows = self.power.to_power.chunks_exact(self.power.points);
+                for (m, row) in rows.enumerate() {
+                    for (i, &w) in row.iter().enumerate().filter(|(_, &w)| w != 0.0) {
+                        for (o, &x) in mat[m * k..(m + 1) * k].iter_mut().zip(&cp[i * k..]) {
+                            *o += w * x;
+                        }
+                    }
+                }
+                cells.push(Cell::Leaf { offset: 0, mat });
+            }
+            Node::Split { children, .. } if depth < SHORTCUT_DEPTH => {
+                cells.push(Cell::Split {
+                    children: Vec::new(),
+                });
+                let mut links = Vec::with_capacity(children.len());
+                for ch in children {
+                    let next = sparse_times_dense(&ch.mat, &acc, k);
+                    links.push((
+                        self.shortcut_cell(ch.node, depth + 1, next, k, cells),
+                        ch.map,
+                    ));
+                }
+                cells[id as usize] = Cell::Split { children: links };
+            }
+            _ => cells.push(Cell::Deep {
+                offset: 0,
+                node,
+                kd: acc.len() / k.max(1),
+                mat: acc,
+            }),
+        }
+        id
+    }
+
+    /// Appends a patch's cached data for shortcut `id` given its local points `pts`.
+    pub fn fill_shortcut(&self, id: u32, pts: &[Point3], out: &mut Vec<Vec3>) {
+        for cell in &self.shortcuts[id as usize].cells {
+            match cell {
+                Cell::Leaf { mat, .. } | Cell::Deep { mat, .. } => apply_dense(mat, pts, out),
+                Cell::Split { .. } => {}
+            }
+        }
+    }
+
+    /// The cell holding (u, v) of shortcut `id`, with the parameters there and the Jacobian of
+    /// those with respect to the patch's.
+    fn walk(&self, id: u32, u: f64, v: f64) -> (&Cell, f64, f64, [[f64; 2]; 2]) {
+        let cells = &self.shortcuts[id as usize].cells;
+        let (mut u, mut v, mut g) = (u, v, [[1.0, 0.0], [0.0, 1.0]]);
+        let mut cell = &cells[0];
+        while let Cell::Split { children } = cell {
+            let ci = if children.len() == 1 {
+                0
+            } else {
+                pick_child(self.scheme, u, v)
+            };
+            let Some(&(next, map)) = children.get(ci) else {
+                break;
+            };
+            (u, v) = map.apply(u, v);
+            g = mul2(map.m, g);
+            cell = &cells[next as usize];
+        }
+        (cell, u, v, g)
+    }
+
+    /// Limit point and derivatives at (u, v) of a patch with shortcut `id` and cached data
+    /// `cache` (from [`Graph::fill_shortcut`]).
+    pub fn eval_shortcut(&self, id: u32, cache: &[Vec3], u: f64, v: f64) -> LimitEval {
+        let (cell, u, v, g) = self.walk(id, u, v);
+        let mut out = match *cell {
+            Cell::Leaf { offset, .. } => {
+                self.power
+                    .eval(&cache[offset..offset + self.power.len()], u, v)
+            }
+            Cell::Deep {
+                offset, node, kd, ..
+            } => self.eval(node, &cache[offset..offset + kd], u, v),
+            Cell::Split { .. } => LimitEval::default(),
+        };
+        chain(&mut out, g);
+        out
+    }
+
+    /// Weights of the patch's local points for the limit position at (u, v), through the
+    /// shortcut `id`.
+    pub fn stencil_shortcut(&self, id: u32, u: f64, v: f64, out: &mut Vec<f64>) {
+        let k = self.shortcuts[id as usize].k;
+        out.clear();
+        out.resize(k, 0.0);
+        let (cell, u, v, _) = self.walk(id, u, v);
+        match cell {
+            Cell::Leaf { mat, .. } => {
+                let mut vals = [0.0; 16];
+                self.power.values(u, v, &mut vals);
+                for (row, &m) in mat.chunks_exact(k.max(1)).zip(&vals) {
+                    for (o, &w) in out.iter_mut().zip(row) {
+                        *o += m * w;
+                    }
+                }
+            }
+            Cell::Deep { node, mat, .. } => {
+                let mut deep = Vec::new();
+                self.stencil(*node, u, v, &mut deep);
+                for (row, &m) in mat.chunks_exact(k.max(1)).zip(&deep) {
+                    for (o, &w) in out.iter_mut().zip(row) {
+                        *o += m * w;
+                    }
+                }
+            }
+            Cell::Split { .. } => {}
         }
     }
 
@@ -538,22 +801,20 @@ impl Graph {
     }
 
     fn intern(&mut self, nb: Neighbourhood, patch: usize) -> Result<u32, SubdivError> {
-        let Neighbourhood {
-            topo, key, kind, ..
-        } = nb;
-        if let Some(&id) = self.index.get(&key) {
+        if let Some(&id) = self.index.get(&nb.key) {
             return Ok(id);
         }
-        if topo.nv > MAX_LOCAL {
+        if nb.len() > MAX_LOCAL {
             return Err(SubdivError::NeighbourhoodTooLarge {
                 patch,
-                points: topo.nv,
+                points: nb.len(),
                 max: MAX_LOCAL,
             });
         }
         let id = self.nodes.len() as u32;
         self.nodes.push(Node::Pending);
-        self.index.insert(key, id);
+        self.index.insert(nb.key.clone(), id);
+        let (topo, kind) = nb.topo();
         self.pending.push((id, topo, kind));
         Ok(id)
     }
@@ -567,7 +828,7 @@ impl Graph {
         map: ChildMap,
         patch: usize,
     ) -> Result<Child, SubdivError> {
-        let kc = nb.topo.nv;
+        let kc = nb.len();
         let mut mat = vec![0.0; kc * k];
         for (row, &p) in nb.source.iter().enumerate() {
             let stencil = refined.points[p as usize]
@@ -780,11 +1041,10 @@ impl Graph {
     fn eval_regular(&self, gather: &Sparse, pts: &[Point3], u: f64, v: f64) -> LimitEval {
         let mut cp = [Vec3::ZERO; 16];
         gather.apply(pts, &mut cp);
-        match self.scheme {
-            Scheme::Loop => combine(&loop_box(u, v), &cp[..12]),
-            Scheme::CatmullClark => combine(&bicubic(u, v), &cp[..16]),
-            Scheme::DooSabin => combine(&biquadratic(u, v), &cp[..9]),
-        }
+        let mut coeffs = Vec::with_capacity(self.power.len());
+        self.power
+            .coefficients(&cp[..self.power.points], &mut coeffs);
+        self.power.eval(&coeffs, u, v)
     }
 
     /// Weights of the patch's local points for the limit position at (u, v).
@@ -802,13 +1062,10 @@ impl Graph {
         }
         let mut w: Vec<f64> = match &self.nodes[path.leaf as usize] {
             Node::Regular { k, gather } => {
-                let basis: Vec<f64> = match self.scheme {
-                    Scheme::Loop => loop_box(path.u, path.v)[0].to_vec(),
-                    Scheme::CatmullClark => bicubic(path.u, path.v)[0].to_vec(),
-                    Scheme::DooSabin => biquadratic(path.u, path.v)[0].to_vec(),
-                };
+                let mut basis = [0.0; 16];
+                self.power.point_weights(path.u, path.v, &mut basis);
                 let mut w = vec![0.0; *k];
-                gather.pull_back(&basis, &mut w);
+                gather.pull_back(&basis[..self.power.points], &mut w);
                 w
             }
             Node::Split { k, .. } => vec![1.0 / (*k).max(1) as f64; *k],
@@ -870,19 +1127,6 @@ fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
         }
     }
     c
-}
-
-/// Sums basis weights times control points.
-pub(crate) fn combine<const N: usize>(w: &[[f64; N]; 6], cp: &[Point3]) -> LimitEval {
-    let s = |d: usize| -> Vec3 { w[d].iter().zip(cp).map(|(&w, &p)| p * w).sum() };
-    LimitEval {
-        point: s(0),
-        du: s(1),
-        dv: s(2),
-        duu: s(3),
-        duv: s(4),
-        dvv: s(5),
-    }
 }
 
 /// Turns derivatives with respect to leaf parameters into ones with respect to the patch's,

@@ -1,7 +1,7 @@
 //! [`SubdivSurface`]: the limit surface of a control mesh under one scheme, with everything
 //! topological precomputed so evaluation after moving control points is only weighted sums.
 
-use super::patch::{combine, neighbourhood, vertex_neighbourhood, Graph, Kind};
+use super::patch::{neighbourhood, vertex_neighbourhood, Graph, Kind};
 use super::topo::{EdgeTag, Topo};
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
 use crate::geom::{Point3, Vec3};
@@ -10,11 +10,14 @@ use crate::mesh::{ControlMesh, NONE};
 /// Where a patch's local points come from, and how to evaluate it.
 #[derive(Clone, Copy, Debug)]
 struct Patch {
-    node: u32,
     start: u32,
     len: u32,
     /// The patch is a plain box spline / B-spline over `ctrl[start..start + len]` in basis order.
     direct: bool,
+    /// The shortcut of the patch's shape (unused when `direct`).
+    shortcut: u32,
+    /// Where the patch's data starts in [`SubdivSurface::cache`].
+    cache: u32,
 }
 
 /// The limit surface of a Loop or Catmull–Clark control mesh.
@@ -27,6 +30,9 @@ pub struct SubdivSurface {
     /// Doo–Sabin the face corner at an interior vertex whose refined point the patch belongs to.
     sites: Vec<(u32, u32)>,
     ctrl: Vec<u32>,
+    /// Per patch, what evaluation needs from the current control points: power coefficients of
+    /// direct patches, the shortcut data of the others. Refilled when control points move.
+    cache: Vec<Vec3>,
     /// Limit stencil of every control vertex (limit masks), flattened.
     limit_starts: Vec<u32>,
     limit_weights: Vec<(u32, f64)>,
@@ -76,6 +82,20 @@ pub(crate) fn topo_of(mesh: &ControlMesh) -> Topo {
 impl SubdivSurface {
     /// The limit surface of `mesh` under `scheme` (Loop needs triangles, Catmull–Clark quads).
     pub fn try_new(scheme: Scheme, mesh: ControlMesh) -> Result<SubdivSurface, SubdivError> {
+        SubdivSurface::with_graph(scheme, mesh, Graph::new(scheme))
+    }
+
+    /// The limit surface of the same scheme over a new control mesh (after refinement): the
+    /// patch shapes already analysed are reused, so only new shapes are subdivided.
+    pub fn with_mesh(&self, mesh: ControlMesh) -> Result<SubdivSurface, SubdivError> {
+        SubdivSurface::with_graph(self.scheme, mesh, self.graph.clone())
+    }
+
+    fn with_graph(
+        scheme: Scheme,
+        mesh: ControlMesh,
+        mut graph: Graph,
+    ) -> Result<SubdivSurface, SubdivError> {
         let needed = match scheme {
             Scheme::Loop => 3,
             Scheme::CatmullClark => 4,
@@ -95,10 +115,10 @@ impl SubdivSurface {
             }
         }
         let topo = topo_of(&mesh);
-        let mut graph = Graph::new(scheme);
         let mut patches = Vec::with_capacity(mesh.num_faces());
         let mut ctrl = Vec::new();
         let sites = patch_sites(scheme, &mesh, &topo);
+        let mut cache_len = 0;
         for (patch, &(f, v)) in sites.iter().enumerate() {
             let nb = match scheme {
                 Scheme::DooSabin => vertex_neighbourhood(&topo, v, f, Kind::DooSabinRoot),
@@ -107,26 +127,22 @@ impl SubdivSurface {
             let source = nb.source.clone();
             let node = graph.add(nb, patch)?;
             let start = ctrl.len() as u32;
-            match graph.direct_picks(node) {
-                Some(picks) => {
-                    ctrl.extend(picks.iter().map(|&p| source[p as usize]));
-                    patches.push(Patch {
-                        node,
-                        start,
-                        len: picks.len() as u32,
-                        direct: true,
-                    });
-                }
+            let (picks, direct, shortcut, data) = match graph.direct_picks(node) {
+                Some(picks) => (picks, true, 0, graph.power().len()),
                 None => {
-                    ctrl.extend_from_slice(&source);
-                    patches.push(Patch {
-                        node,
-                        start,
-                        len: source.len() as u32,
-                        direct: false,
-                    });
+                    let (id, len) = graph.shortcut(node);
+                    ((0..source.len() as u32).collect(), false, id, len)
                 }
-            }
+            };
+            ctrl.extend(picks.iter().map(|&p| source[p as usize]));
+            patches.push(Patch {
+                start,
+                len: picks.len() as u32,
+                direct,
+                shortcut,
+                cache: cache_len as u32,
+            });
+            cache_len += data;
         }
         let mut limit_starts = vec![0u32];
         let mut limit_weights = Vec::new();
@@ -139,16 +155,37 @@ impl SubdivSurface {
             limit_weights.extend(s);
             limit_starts.push(limit_weights.len() as u32);
         }
-        Ok(SubdivSurface {
+        let mut surface = SubdivSurface {
             scheme,
             mesh,
             graph,
             patches,
             sites,
             ctrl,
+            cache: Vec::with_capacity(cache_len),
             limit_starts,
             limit_weights,
-        })
+        };
+        surface.fill_cache();
+        Ok(surface)
+    }
+
+    /// Recomputes every patch's cached data from the current control points.
+    fn fill_cache(&mut self) {
+        self.cache.clear();
+        let pts = self.mesh.positions();
+        let mut local = Vec::with_capacity(super::patch::MAX_LOCAL);
+        for p in &self.patches {
+            local.clear();
+            let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
+            local.extend(idx.iter().map(|&i| pts[i as usize]));
+            if p.direct {
+                self.graph.power().coefficients(&local, &mut self.cache);
+            } else {
+                self.graph
+                    .fill_shortcut(p.shortcut, &local, &mut self.cache);
+            }
+        }
     }
 
     /// The control face and vertex of `patch`: for Loop and Catmull–Clark the face (and its
@@ -208,19 +245,6 @@ impl SubdivSurface {
                 e.du.cross(e.dv).normalize_or_zero()
             })
             .collect()
-    }
-
-    fn local_points<'a>(
-        &self,
-        p: &Patch,
-        buf: &'a mut [Point3; super::patch::MAX_LOCAL],
-    ) -> &'a [Point3] {
-        let pts = self.mesh.positions();
-        let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
-        for (b, &i) in buf.iter_mut().zip(idx) {
-            *b = pts[i as usize];
-        }
-        &buf[..idx.len()]
     }
 
     fn patch(&self, at: SurfaceParam) -> Option<(&Patch, f64, f64)> {
@@ -314,27 +338,19 @@ impl LimitSurface for SubdivSurface {
 
     fn set_control_points(&mut self, points: &[Point3]) {
         self.mesh.set_positions(points);
+        self.fill_cache();
     }
 
     fn eval(&self, at: SurfaceParam) -> LimitEval {
         let Some((p, u, v)) = self.patch(at) else {
             return LimitEval::default();
         };
+        let cache = &self.cache[p.cache as usize..];
         if p.direct {
-            let pts = self.mesh.positions();
-            let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
-            let mut cp = [Point3::ZERO; 16];
-            for (c, &i) in cp.iter_mut().zip(idx) {
-                *c = pts[i as usize];
-            }
-            return match self.scheme {
-                Scheme::Loop => combine(&super::basis::loop_box(u, v), &cp[..12]),
-                _ => combine(&super::basis::bicubic(u, v), &cp[..16]),
-            };
+            self.graph.power().eval(cache, u, v)
+        } else {
+            self.graph.eval_shortcut(p.shortcut, cache, u, v)
         }
-        let mut buf = [Point3::ZERO; super::patch::MAX_LOCAL];
-        let local = self.local_points(p, &mut buf);
-        self.graph.eval(p.node, local, u, v)
     }
 
     fn stencil(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>) {
@@ -342,16 +358,14 @@ impl LimitSurface for SubdivSurface {
             return;
         };
         let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
-        let weights: Vec<f64> = if p.direct {
-            match self.scheme {
-                Scheme::Loop => super::basis::loop_box(u, v)[0].to_vec(),
-                _ => super::basis::bicubic(u, v)[0].to_vec(),
-            }
+        let mut weights = [0.0; super::patch::MAX_LOCAL];
+        if p.direct {
+            self.graph.power().point_weights(u, v, &mut weights);
         } else {
             let mut w = Vec::with_capacity(idx.len());
-            self.graph.stencil(p.node, u, v, &mut w);
-            w
-        };
+            self.graph.stencil_shortcut(p.shortcut, u, v, &mut w);
+            weights[..w.len().min(idx.len())].copy_from_slice(&w[..w.len().min(idx.len())]);
+        }
         let start = out.len();
         for (&i, &w) in idx.iter().zip(&weights) {
             if w != 0.0 {
