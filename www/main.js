@@ -196,6 +196,21 @@ function bindCamera() {
     const typing = e.target instanceof HTMLInputElement && e.target.type !== 'checkbox';
     if (!typing && (e.key === 'f' || e.key === 'F') && !e.ctrlKey && !e.metaKey) fit();
   });
+  // With the view focused: arrow keys rotate (shift + arrows pan), + and − zoom.
+  const KEY_STEP = 20;
+  const arrows = { ArrowLeft: [-KEY_STEP, 0], ArrowRight: [KEY_STEP, 0], ArrowUp: [0, -KEY_STEP], ArrowDown: [0, KEY_STEP] };
+  c.addEventListener('keydown', (e) => {
+    if (!viewer) return;
+    if (arrows[e.key]) {
+      const [dx, dy] = arrows[e.key];
+      if (e.shiftKey) viewer.pan(dx, dy);
+      else viewer.orbit(dx, dy);
+    } else if (e.key === '+' || e.key === '=') viewer.zoom(-100);
+    else if (e.key === '-') viewer.zoom(100);
+    else return;
+    e.preventDefault();
+    requestRender();
+  });
 }
 
 function bindFiles() {

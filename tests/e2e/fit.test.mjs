@@ -55,7 +55,10 @@ function chartPixels(page, hex) {
 
 const fitIter = (page) => page.evaluate(() => Number(document.body.dataset.fitIter ?? -1));
 
-/** Counts canvas pixels of the view by class: curve orange, iso cyan, zebra dark grey and white. */
+/**
+ * Counts canvas pixels of the view by class: curve orange, iso cyan, initial net violet, zebra
+ * dark grey and white, lit clay.
+ */
 async function viewPixels(page, file) {
   const png = await page.locator('#view').screenshot();
   saveArtifact(file, png);
@@ -67,11 +70,12 @@ async function viewPixels(page, file) {
     const ctx = c.getContext('2d');
     ctx.drawImage(img, 0, 0);
     const { data } = ctx.getImageData(0, 0, img.width, img.height);
-    const n = { orange: 0, cyan: 0, black: 0, white: 0, clay: 0 };
+    const n = { orange: 0, cyan: 0, violet: 0, black: 0, white: 0, clay: 0 };
     for (let i = 0; i < data.length; i += 4) {
       const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
       if (r > 200 && g > 100 && g < 180 && b < 60) n.orange += 1;
       if (b > 200 && g > 170 && r < 130) n.cyan += 1;
+      if (b > 220 && r > 150 && r < 225 && g > 100 && g < 175) n.violet += 1;
       if (r < 90 && Math.abs(r - g) < 5 && Math.abs(r - b) < 5) n.black += 1;
       if (r > 200 && g > 200 && b > 200 && Math.abs(r - b) < 12) n.white += 1;
       if (r > 120 && r - b > 15 && r - b < 60 && Math.abs(r - g) < 25) n.clay += 1;
@@ -236,6 +240,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     const points = await errorPixels(page, `fit-converged-points-${backend.name}.png`);
     await page.check('#show-mesh');
     saveArtifact(`fit-page-${backend.name}.png`, await page.screenshot({ fullPage: true }));
+    saveArtifact(`fit-chart-${backend.name}.png`, await page.locator('#fit-chart').screenshot());
     assert.ok(px.pale > 100, `surface drawn: ${JSON.stringify(px)}`);
     assert.ok(points.pale > 50, `pale (within tolerance) points drawn: ${JSON.stringify(points)}`);
     assert.ok(points.red + points.blue < points.pale, `few points outside: ${JSON.stringify(points)}`);
@@ -310,6 +315,11 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     await page.waitForTimeout(300);
     const iso = await viewPixels(page, `fit-bspline-iso-${backend.name}.png`);
     await page.uncheck('#show-iso');
+    await page.check('#show-initial');
+    await page.waitForTimeout(300);
+    const initial = await viewPixels(page, `fit-bspline-initial-${backend.name}.png`);
+    await page.uncheck('#show-initial');
+    assert.ok(initial.violet > 200 && initial.cyan < 50, `initial control net drawn: ${JSON.stringify(initial)}`);
     await page.uncheck('#show-points');
     await page.check('#show-zebra');
     await page.waitForTimeout(300);
@@ -370,6 +380,19 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     } finally {
       await embed.close();
     }
+  });
+
+  test('keyboard: arrow keys turn the focused view; every control has a label', async () => {
+    const before = await page.locator('#view').screenshot();
+    await page.focus('#view');
+    for (let k = 0; k < 3; k += 1) await page.keyboard.press('ArrowLeft');
+    await page.waitForTimeout(300);
+    const after = await page.locator('#view').screenshot();
+    assert.ok(!before.equals(after), 'the arrow keys changed nothing');
+    const unlabelled = await page.evaluate(() => [...document.querySelectorAll('input, select, button')]
+      .filter((e) => !(e.labels?.length || e.getAttribute('aria-label') || e.textContent.trim()))
+      .map((e) => e.id || e.outerHTML));
+    assert.deepEqual(unlabelled, []);
   });
 
   test('the page logged no errors', () => {
