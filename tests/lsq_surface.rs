@@ -156,7 +156,7 @@ fn adaptive_splitting_meets_the_tolerance() {
         let opts = LsqSurfaceOptions::default()
             .with_control(4, 4)
             .with_tolerance(0.05, mode)
-            .with_min_points_to_split(4)
+            .with_min_sample(4)
             .with_betas(1e-9, 1e-12);
         let mut fit = LsqSurfaceFitter::try_new(&points, opts).unwrap();
         assert_eq!(

@@ -11,7 +11,9 @@ use super::accel::Accelerator;
 use super::lsq_surface::{check_common, plane_surface};
 use super::options::Acceleration;
 use super::parameterize::{check_points, parameterize, ParamOptions};
-use super::patches::{correct_parameters, patch_errors, split_worst, PatchGrid, TolMode};
+use super::patches::{
+    correct_parameters, patch_errors, split_worst, Criterion, PatchGrid, TolMode,
+};
 use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
 use crate::geom::{Aabb, Point3, Vec3};
 use crate::spline::BSplineSurface;
@@ -38,8 +40,9 @@ pub struct GeometricSurfaceOptions {
     pub iterations_per_knots: usize,
     /// Cap on the control-point count. Default 40,000.
     pub max_control_points: usize,
-    /// A patch with fewer points than this is not split further. Default 16.
-    pub min_points_to_split: usize,
+    /// In [`TolMode::Noisy`], a patch with fewer points than this is judged on the points of
+    /// its 3 × 3 patch neighbourhood. Default 16.
+    pub min_sample: usize,
     /// Iteration cap. Default 200.
     pub max_iterations: usize,
     /// Newton iterations per point and iteration (warm-started). Default 3.
@@ -59,7 +62,7 @@ impl Default for GeometricSurfaceOptions {
             acceleration: Acceleration::Anderson { depth: 5 },
             iterations_per_knots: 12,
             max_control_points: 40_000,
-            min_points_to_split: 16,
+            min_sample: 16,
             max_iterations: 200,
             newton_iterations: 3,
             param: ParamOptions::default(),
@@ -292,8 +295,11 @@ impl Fitter for GeometricSurfaceFitter {
             &self.uv,
             &self.dist,
             &self.active,
-            tol,
-            self.opts.tol_mode,
+            Criterion {
+                tol,
+                mode: self.opts.tol_mode,
+                min_sample: self.opts.min_sample,
+            },
         );
         let stalled = self.stats().e_rms > 0.99 * rms_before;
         let mut refined = false;
@@ -315,7 +321,6 @@ impl Fitter for GeometricSurfaceFitter {
                 &grid,
                 &errors,
                 self.opts.max_control_points,
-                self.opts.min_points_to_split,
             );
             refined = inserted > 0;
             self.iters_at_knots = 0;

@@ -17,7 +17,7 @@
 
 use super::parameterize::{parameterize, ParamOptions, Parameterization};
 use super::patches::{
-    correct_parameters, patch_errors, split_worst, PatchError, PatchGrid, TolMode,
+    correct_parameters, patch_errors, split_worst, Criterion, PatchError, PatchGrid, TolMode,
 };
 use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
 use crate::geom::{Aabb, Point3};
@@ -50,8 +50,10 @@ pub struct LsqSurfaceOptions {
     pub tol_mode: TolMode,
     /// Cap on the control-point count when splitting. Default 40,000.
     pub max_control_points: usize,
-    /// A patch with fewer points than this is not split further. Default 16.
-    pub min_points_to_split: usize,
+    /// In [`TolMode::Noisy`], a patch with fewer points than this is judged on the points of
+    /// its 3 × 3 patch neighbourhood (a 95 % share or a standard deviation of a handful of
+    /// points says nothing about noise). Default 16.
+    pub min_sample: usize,
     /// Solves (each followed by parameter correction) per knot vector. Default 2.
     pub solves_per_knots: usize,
     /// Iteration cap. Default 30.
@@ -73,7 +75,7 @@ impl Default for LsqSurfaceOptions {
             tol_pct: 0.1,
             tol_mode: TolMode::Noisy,
             max_control_points: 40_000,
-            min_points_to_split: 16,
+            min_sample: 16,
             solves_per_knots: 2,
             max_iterations: 30,
             newton_iterations: 4,
@@ -125,9 +127,9 @@ impl LsqSurfaceOptions {
         self.max_control_points = n;
         self
     }
-    /// Sets the smallest patch (in points) that may still be split.
-    pub fn with_min_points_to_split(mut self, n: usize) -> Self {
-        self.min_points_to_split = n;
+    /// Sets the smallest sample (in points) of the noisy patch test.
+    pub fn with_min_sample(mut self, n: usize) -> Self {
+        self.min_sample = n;
         self
     }
     /// Sets the parameterisation options.
@@ -225,6 +227,9 @@ pub struct LsqSurfaceFitter {
     system: Option<NormalSystem>,
     solves_at_knots: usize,
     initial_control: usize,
+    /// Parameter area of an initial patch over the domain's: the reference of the per-patch
+    /// weight scaling (see [`patch_weights`]).
+    ref_cell_area: f64,
     precompute_s: f64,
     status: FitStatus,
 }
@@ -280,6 +285,7 @@ impl LsqSurfaceFitter {
             num_folded: param.num_folded,
             uv: param.uv,
             initial_control: nu * nv,
+            ref_cell_area: 1.0 / PatchGrid::of(&surface).len().max(1) as f64,
             surface,
             opts,
             diagonal,
@@ -357,12 +363,19 @@ impl LsqSurfaceFitter {
             count += 1;
         }
         let grid = PatchGrid::of(&self.surface);
-        let density = patch_density(&self.surface, &grid, &self.uv, &self.active, count);
+        let weights = patch_weights(
+            &self.surface,
+            &grid,
+            &self.uv,
+            &self.active,
+            count,
+            self.ref_cell_area,
+        );
         let scale = count.max(1) as f64;
         system.add_energies(
             &self.surface,
             &grid,
-            &density,
+            &weights,
             self.opts.beta2 * scale,
             self.opts.beta3 * scale,
         );
@@ -398,8 +411,11 @@ impl Fitter for LsqSurfaceFitter {
             &self.uv,
             &self.dist,
             &self.active,
-            tol,
-            self.opts.tol_mode,
+            Criterion {
+                tol,
+                mode: self.opts.tol_mode,
+                min_sample: self.opts.min_sample,
+            },
         );
         let all_pass = errors.iter().all(|e| e.pass);
         let mut refined = false;
@@ -417,7 +433,6 @@ impl Fitter for LsqSurfaceFitter {
                 &grid,
                 &errors,
                 self.opts.max_control_points,
-                self.opts.min_points_to_split,
             );
             refined = inserted > 0;
             self.solves_at_knots = 0;
@@ -454,15 +469,25 @@ impl Fitter for LsqSurfaceFitter {
     }
 }
 
-/// Relative point density ρ of every patch: (points per parameter area) / (points per whole
-/// domain area), kept within [1/64, 64] so empty patches get a finite weight.
-fn patch_density(
+/// The factors of β2 and β3 of every patch: 1/ρ and ρ (SPEC §2), with ρ the relative point
+/// density (points per parameter area over points per domain area, kept within [1/64, 64] so
+/// empty patches get a finite weight), times s² and s³ for s = the patch's parameter area over
+/// `ref_area` (at most 1).
+///
+/// Why s: a feature that a patch of width h must follow has S_uu ~ 1/h² and S_uuu ~ 1/h³, so
+/// against the data term of the patch's points the thin-plate energy grows like 1/h⁴ and the
+/// curvature-variation energy like 1/h⁶ as patches are split. Without s, splitting would make
+/// the fit stiffer exactly where it must follow the data more closely, and the adaptive fit
+/// could not reach a fine tolerance; with s, a split patch is smoothed as much, relative to its
+/// own size, as the initial patches.
+fn patch_weights(
     surface: &BSplineSurface,
     grid: &PatchGrid,
     uv: &[[f64; 2]],
     active: &[bool],
     count: usize,
-) -> Vec<f64> {
+    ref_area: f64,
+) -> Vec<[f64; 2]> {
     let mut counts = vec![0usize; grid.len()];
     for (t, _) in uv.iter().zip(active).filter(|x| *x.1) {
         counts[grid.patch(surface, t[0], t[1])] += 1;
@@ -479,8 +504,9 @@ fn patch_density(
                 grid.v.knot_index(i % grid.v.len()),
             );
             let cell_area = (ku[su + 1] - ku[su]) * (kv[sv + 1] - kv[sv]) / area;
-            let rho = c as f64 / (cell_area * count.max(1) as f64);
-            rho.clamp(1.0 / 64.0, 64.0)
+            let rho = (c as f64 / (cell_area * count.max(1) as f64)).clamp(1.0 / 64.0, 64.0);
+            let s = (cell_area / ref_area).min(1.0);
+            [s * s / rho, s * s * s * rho]
         })
         .collect()
 }
@@ -693,7 +719,7 @@ impl NormalSystem {
         &mut self,
         s: &BSplineSurface,
         grid: &PatchGrid,
-        density: &[f64],
+        weights: &[[f64; 2]],
         beta2: f64,
         beta3: f64,
     ) {
@@ -709,8 +735,8 @@ impl NormalSystem {
             let fu = grid.u.knot_index(cu) - gu.degree;
             for (cv, gv) in grams_v.iter().enumerate() {
                 let fv = grid.v.knot_index(cv) - gv.degree;
-                let rho = density[cu * grid.v.len() + cv];
-                let (b2, b3) = (beta2 / rho, beta3 * rho);
+                let [w2, w3] = weights[cu * grid.v.len() + cv];
+                let (b2, b3) = (beta2 * w2, beta3 * w3);
                 for_cell_pairs(&gu, gv, |a, b, c, d, w2, w3| {
                     let (col, row) = ((fu + a) * nv + fv + b, (fu + c) * nv + fv + d);
                     if row <= col {
