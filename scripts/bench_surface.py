@@ -128,7 +128,7 @@ def stats(d, diag):
 def run_geofit(binary, data, extra):
     with tempfile.TemporaryDirectory() as tmp:
         sj = os.path.join(tmp, "s.json")
-        cmd = [binary, "fit-bspline", data, "--surface-json", sj] + extra
+        cmd = [binary, "fit", data, "--scheme", "bspline", "--surface-json", sj] + extra
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         w = time.perf_counter()
         out = subprocess.run(cmd, capture_output=True, text=True)

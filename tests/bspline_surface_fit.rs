@@ -184,5 +184,26 @@ fn cli_fit_scheme_bspline_writes_the_report() {
         .unwrap();
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("not a square"));
+    // Options of one branch given to the other are errors, not silently ignored.
+    for (args, message) in [
+        (
+            vec!["--scheme", "loop", "--method", "geometric"],
+            "--method applies to --scheme bspline only",
+        ),
+        (
+            vec!["--scheme", "bspline", "--tol-avg", "0.01"],
+            "--tol-avg does not apply to --scheme bspline",
+        ),
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
+            .arg("fit")
+            .arg(&data)
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(message), "{err}");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -21,6 +21,9 @@ pub enum SchemeArg {
     CatmullClark,
     /// Doo–Sabin subdivision surface.
     DooSabin,
+    /// One tensor-product B-spline surface (options under "B-spline surface"; --tol-max
+    /// defaults to 0.1 there, and the JSON report is printed).
+    Bspline,
 }
 
 /// Error-vector weighting.
@@ -113,6 +116,8 @@ pub struct Args {
     /// Print only the summary, not one line per iteration.
     #[arg(long, short)]
     quiet: bool,
+    #[command(flatten)]
+    bspline: crate::fit_bspline::BsplineArgs,
 }
 
 impl Args {
@@ -161,19 +166,46 @@ fn read(path: &Path) -> Result<PolyMesh, String> {
 }
 
 pub fn run(args: Args) -> Result<(), String> {
-    let start = Instant::now();
-    let data = read(&args.file)?;
-    let control = args.control.as_deref().map(read).transpose()?;
     let scheme = match args.scheme {
         SchemeArg::Loop => Scheme::Loop,
         SchemeArg::CatmullClark => Scheme::CatmullClark,
         SchemeArg::DooSabin => Scheme::DooSabin,
+        SchemeArg::Bspline => return run_bspline(&args),
     };
+    if let Some(flag) = args.bspline.first_given() {
+        return Err(format!("{flag} applies to --scheme bspline only"));
+    }
+    let start = Instant::now();
+    let data = read(&args.file)?;
+    let control = args.control.as_deref().map(read).transpose()?;
     let fitter = build_subdiv_fitter(&data, scheme, control, args.initial, args.options())
         .map_err(|e| e.to_string())?;
     // Reading and QEM count as precompute; the report adds the fitter's own set-up time.
     let before_fitter = (start.elapsed().as_secs_f64() - fitter.precompute_seconds()).max(0.0);
     drive(fitter, before_fitter, &args)
+}
+
+/// The `--scheme bspline` branch: the shared options that apply, then the B-spline fit.
+fn run_bspline(args: &Args) -> Result<(), String> {
+    let unsupported = [
+        ("--tol-avg", args.tol_avg.is_some()),
+        ("--tol-rms", args.tol_rms.is_some()),
+        ("--initial", args.initial.is_some()),
+        ("--control", args.control.is_some()),
+        ("--cage", args.cage.is_some()),
+        ("--limit", args.limit.is_some()),
+    ];
+    if let Some((flag, _)) = unsupported.iter().find(|f| f.1) {
+        return Err(format!("{flag} does not apply to --scheme bspline"));
+    }
+    let common = crate::fit_bspline::Common {
+        file: &args.file,
+        tol_max: args.tol_max,
+        max_iter: args.max_iter,
+        max_control: args.max_control,
+        json: args.json.as_deref(),
+    };
+    crate::fit_bspline::run(common, &args.bspline)
 }
 
 /// Iterates to the end, printing progress, then writes the outputs.

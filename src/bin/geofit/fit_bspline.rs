@@ -1,7 +1,8 @@
-//! `geofit fit-bspline FILE [--degree 3] [--method geometric|least-squares] [--beta2 X]
-//! [--beta3 X] [--tol-max PCT] [--tol-mode exact|noisy] [--ctrl N | --ctrl-u N --ctrl-v N]
-//! [--json R.json] [--surface-json S.json] [--iges OUT.igs] [--step OUT.stp]`: fit one tensor-product B-spline surface to a scan
-//! (the `--scheme bspline` branch of `geofit fit`, routed here by [`route`]).
+//! `geofit fit FILE --scheme bspline [--degree 3] [--method geometric|least-squares]
+//! [--beta2 X] [--beta3 X] [--tol-max PCT] [--tol-mode exact|noisy]
+//! [--ctrl N | --ctrl-u N --ctrl-v N] [--json R.json] [--surface-json S.json] [--iges OUT.igs]
+//! [--step OUT.stp]`: the `--scheme bspline` branch of `geofit fit`, fitting one
+//! tensor-product B-spline surface to a scan. Its options are flattened into `geofit fit`'s.
 
 use geofit::export::{iges::write_iges, step::write_step, ExportModel, SurfaceDesc};
 use geofit::fit::{
@@ -11,7 +12,7 @@ use geofit::fit::{
 use geofit::geom::Vec3;
 use geofit::spline::BSplineSurface;
 use serde::Serialize;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Fitting method.
@@ -28,7 +29,8 @@ pub enum Method {
 pub enum TolModeArg {
     /// Every patch's largest distance within the tolerance.
     Exact,
-    /// More than 95 % of every patch's points within the tolerance.
+    /// Every patch has more than 95 % of its points within the tolerance, or mean + standard
+    /// deviation of its distances within it (patches under 16 points: with their neighbours).
     Noisy,
 }
 
@@ -43,29 +45,26 @@ pub enum FoldArg {
     Keep,
 }
 
-/// Arguments of the B-spline surface fit.
-#[derive(clap::Args, Debug)]
-pub struct Args {
-    /// Point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS); only the points are used.
-    file: PathBuf,
-    /// Degree in u and v.
-    #[arg(long, default_value_t = 3)]
-    degree: usize,
-    /// Fitting method.
-    #[arg(long, value_enum, default_value_t = Method::LeastSquares)]
-    method: Method,
-    /// Thin-plate weight β2 (least squares).
+/// Options of `geofit fit --scheme bspline` (flattened into `geofit fit`; all optional so that
+/// giving one with another scheme is reported).
+#[derive(clap::Args, Debug, Default)]
+#[command(next_help_heading = "B-spline surface (--scheme bspline)")]
+pub struct BsplineArgs {
+    /// Degree in u and v [default: 3].
+    #[arg(long)]
+    degree: Option<usize>,
+    /// Fitting method [default: least-squares].
+    #[arg(long, value_enum)]
+    method: Option<Method>,
+    /// Thin-plate weight β2 (least squares) [default: 1e-12].
     #[arg(long)]
     beta2: Option<f64>,
-    /// Curvature-variation weight β3 (least squares).
+    /// Curvature-variation weight β3 (least squares) [default: 1e-15].
     #[arg(long)]
     beta3: Option<f64>,
-    /// Tolerance, % of the bounding-box diagonal.
-    #[arg(long, default_value_t = 0.1)]
-    tol_max: f64,
-    /// How patches are judged against the tolerance.
-    #[arg(long, value_enum, default_value_t = TolModeArg::Noisy)]
-    tol_mode: TolModeArg,
+    /// How patches are judged against --tol-max [default: noisy].
+    #[arg(long, value_enum)]
+    tol_mode: Option<TolModeArg>,
     /// Fixed control-point count N (a √N × √N grid, knots kept fixed).
     #[arg(long, conflicts_with_all = ["ctrl_u", "ctrl_v"])]
     ctrl: Option<usize>,
@@ -75,27 +74,19 @@ pub struct Args {
     /// Fixed control points along v (with --ctrl-u).
     #[arg(long, requires = "ctrl_u")]
     ctrl_v: Option<usize>,
-    /// Initial control points per direction when splitting adaptively.
-    #[arg(long, default_value_t = 8)]
-    initial_ctrl: usize,
-    /// Cap on control points when splitting.
-    #[arg(long, default_value_t = 40_000)]
-    max_ctrl: usize,
-    /// Iteration cap.
+    /// Initial control points per direction when splitting adaptively [default: 8].
     #[arg(long)]
-    max_iter: Option<usize>,
-    /// Least squares: solves (each followed by parameter correction) per knot vector.
-    #[arg(long, default_value_t = 2)]
-    solves: usize,
-    /// View direction "x,y,z" for the projection (default: least-variance axis).
+    initial_ctrl: Option<usize>,
+    /// Least squares: solves (each followed by parameter correction) per knot vector
+    /// [default: 2].
+    #[arg(long)]
+    solves: Option<usize>,
+    /// View direction "x,y,z" for the projection [default: least-variance axis].
     #[arg(long, value_parser = parse_vec3)]
     view: Option<Vec3>,
-    /// Points on a fold-over of the projection.
-    #[arg(long, value_enum, default_value_t = FoldArg::Keep)]
-    folded: FoldArg,
-    /// Write the report as JSON to this file.
-    #[arg(long)]
-    json: Option<PathBuf>,
+    /// Points on a fold-over of the projection [default: keep].
+    #[arg(long, value_enum)]
+    folded: Option<FoldArg>,
     /// Write the fitted surface (degree, knots, control grid) as JSON to this file.
     #[arg(long)]
     surface_json: Option<PathBuf>,
@@ -107,37 +98,41 @@ pub struct Args {
     step: Option<PathBuf>,
 }
 
-/// Lets `geofit fit FILE --scheme bspline ...` reach this command: rewrites the arguments to
-/// `geofit fit-bspline FILE ...` when the `fit` subcommand asks for the bspline scheme.
-pub fn route(args: Vec<std::ffi::OsString>) -> Vec<std::ffi::OsString> {
-    let is = |a: &std::ffi::OsString, s: &str| a.to_str() == Some(s);
-    if args.len() < 2 || !is(&args[1], "fit") {
-        return args;
+impl BsplineArgs {
+    /// The first B-spline-only option given, if any (they are an error with other schemes).
+    pub fn first_given(&self) -> Option<&'static str> {
+        let given = [
+            ("--degree", self.degree.is_some()),
+            ("--method", self.method.is_some()),
+            ("--beta2", self.beta2.is_some()),
+            ("--beta3", self.beta3.is_some()),
+            ("--tol-mode", self.tol_mode.is_some()),
+            ("--ctrl", self.ctrl.is_some()),
+            ("--ctrl-u", self.ctrl_u.is_some()),
+            ("--initial-ctrl", self.initial_ctrl.is_some()),
+            ("--solves", self.solves.is_some()),
+            ("--view", self.view.is_some()),
+            ("--folded", self.folded.is_some()),
+            ("--surface-json", self.surface_json.is_some()),
+            ("--iges", self.iges.is_some()),
+            ("--step", self.step.is_some()),
+        ];
+        given.iter().find(|g| g.1).map(|g| g.0)
     }
-    let pos = args.iter().position(|a| is(a, "--scheme"));
-    let bspline = match pos {
-        Some(i) => args.get(i + 1).is_some_and(|a| is(a, "bspline")),
-        None => args.iter().any(|a| is(a, "--scheme=bspline")),
-    };
-    if !bspline {
-        return args;
-    }
-    let mut out = vec![args[0].clone(), "fit-bspline".into()];
-    let mut skip = false;
-    for (i, a) in args.iter().enumerate().skip(2) {
-        if skip {
-            skip = false;
-            continue;
-        }
-        if Some(i) == pos {
-            skip = true;
-            continue;
-        }
-        if !is(a, "--scheme=bspline") {
-            out.push(a.clone());
-        }
-    }
-    out
+}
+
+/// The options `geofit fit` shares with the other schemes.
+pub struct Common<'a> {
+    /// The data file.
+    pub file: &'a Path,
+    /// Tolerance, % of the bounding-box diagonal (default 0.1).
+    pub tol_max: Option<f64>,
+    /// Iteration cap.
+    pub max_iter: usize,
+    /// Control-point budget of the splitting (default 40,000).
+    pub max_control: Option<usize>,
+    /// Where to write the JSON report.
+    pub json: Option<&'a Path>,
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -175,42 +170,45 @@ struct SurfaceJson<'a> {
     control_points: Vec<[f64; 3]>,
 }
 
-/// Reads the file, fits, prints the report and writes the requested files.
-pub fn run(args: Args) -> Result<(), String> {
+/// Reads the file, fits, prints the report (JSON) and writes the requested files.
+pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
     let start = Instant::now();
-    let loaded =
-        geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
+    let file = common.file;
+    let loaded = geofit::io::read_path(file).map_err(|e| format!("{}: {e}", file.display()))?;
     let points = loaded.mesh.positions().to_vec();
     let read_s = start.elapsed().as_secs_f64();
-    let mut param = ParamOptions::default().with_fold_policy(match args.folded {
-        FoldArg::Fail => FoldPolicy::Fail,
-        FoldArg::Exclude => FoldPolicy::Exclude,
-        FoldArg::Keep => FoldPolicy::Keep,
-    });
+    let mut param =
+        ParamOptions::default().with_fold_policy(match args.folded.unwrap_or(FoldArg::Keep) {
+            FoldArg::Fail => FoldPolicy::Fail,
+            FoldArg::Exclude => FoldPolicy::Exclude,
+            FoldArg::Keep => FoldPolicy::Keep,
+        });
     if let Some(v) = args.view {
         param = param.with_view(v);
     }
-    let mode = match args.tol_mode {
+    let mode = match args.tol_mode.unwrap_or(TolModeArg::Noisy) {
         TolModeArg::Exact => TolMode::Exact,
         TolModeArg::Noisy => TolMode::Noisy,
     };
-    let fixed = fixed_control(&args)?;
-    let control = fixed.unwrap_or((args.initial_ctrl, args.initial_ctrl));
-    let (report, surface) = match args.method {
+    let fixed = fixed_control(args)?;
+    let initial = args.initial_ctrl.unwrap_or(8);
+    let control = fixed.unwrap_or((initial, initial));
+    let degree = args.degree.unwrap_or(3);
+    let tol_max = common.tol_max.unwrap_or(0.1);
+    let max_ctrl = common.max_control.unwrap_or(40_000);
+    let (report, surface) = match args.method.unwrap_or(Method::LeastSquares) {
         Method::LeastSquares => {
-            let mut opts = LsqSurfaceOptions::default()
-                .with_degree(args.degree)
+            let d = LsqSurfaceOptions::default();
+            let opts = d
+                .with_degree(degree)
                 .with_control(control.0, control.1)
                 .with_fixed_knots(fixed.is_some())
-                .with_tolerance(args.tol_max, mode)
-                .with_max_control_points(args.max_ctrl)
-                .with_solves_per_knots(args.solves)
-                .with_param(param);
-            let d = LsqSurfaceOptions::default();
-            opts = opts.with_betas(args.beta2.unwrap_or(d.beta2), args.beta3.unwrap_or(d.beta3));
-            if let Some(n) = args.max_iter {
-                opts = opts.with_max_iterations(n);
-            }
+                .with_tolerance(tol_max, mode)
+                .with_max_control_points(max_ctrl)
+                .with_solves_per_knots(args.solves.unwrap_or(d.solves_per_knots))
+                .with_param(param)
+                .with_betas(args.beta2.unwrap_or(d.beta2), args.beta3.unwrap_or(d.beta3))
+                .with_max_iterations(common.max_iter);
             let mut fitter = LsqSurfaceFitter::try_new(&points, opts).map_err(|e| e.to_string())?;
             let t = Instant::now();
             let status = fitter.run().map_err(|e| e.to_string())?;
@@ -230,16 +228,14 @@ pub fn run(args: Args) -> Result<(), String> {
             )
         }
         Method::Geometric => {
-            let mut opts = GeometricSurfaceOptions::default()
-                .with_degree(args.degree)
+            let opts = GeometricSurfaceOptions::default()
+                .with_degree(degree)
                 .with_control(control.0, control.1)
                 .with_fixed_knots(fixed.is_some())
-                .with_tolerance(args.tol_max, mode)
-                .with_max_control_points(args.max_ctrl)
-                .with_param(param);
-            if let Some(n) = args.max_iter {
-                opts = opts.with_max_iterations(n);
-            }
+                .with_tolerance(tol_max, mode)
+                .with_max_control_points(max_ctrl)
+                .with_param(param)
+                .with_max_iterations(common.max_iter);
             let mut fitter =
                 GeometricSurfaceFitter::try_new(&points, opts).map_err(|e| e.to_string())?;
             let t = Instant::now();
@@ -262,7 +258,7 @@ pub fn run(args: Args) -> Result<(), String> {
     };
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
     println!("{text}");
-    if let Some(path) = &args.json {
+    if let Some(path) = common.json {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     let model = ExportModel {
@@ -278,8 +274,7 @@ pub fn run(args: Args) -> Result<(), String> {
             weights: surface.weights().map(<[f64]>::to_vec),
         }],
     };
-    let name = args
-        .file
+    let name = file
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("geofit");
@@ -298,7 +293,7 @@ pub fn run(args: Args) -> Result<(), String> {
     Ok(())
 }
 
-fn fixed_control(args: &Args) -> Result<Option<(usize, usize)>, String> {
+fn fixed_control(args: &BsplineArgs) -> Result<Option<(usize, usize)>, String> {
     if let Some(n) = args.ctrl {
         let side = (n as f64).sqrt().round() as usize;
         if side * side != n {

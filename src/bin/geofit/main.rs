@@ -23,6 +23,9 @@ struct Cli {
     command: Command,
 }
 
+// Parsed once per process: the size of the `fit` variant (it carries the B-spline options too)
+// costs nothing worth boxing for.
+#[allow(clippy::large_enum_variant)]
 #[derive(Subcommand)]
 enum Command {
     /// Describe a point or mesh file.
@@ -33,8 +36,6 @@ enum Command {
     /// Write reference curves and surfaces as IGES and STEP with sampled points (for
     /// interoperability tests).
     ExportSamples(export_samples::Args),
-    /// Fit one tensor-product B-spline surface to a scan (least squares or geometric).
-    FitBspline(fit_bspline::Args),
     /// Simplify a mesh by quadric error metrics to a target vertex count (the initial control
     /// mesh of a fit), timed, with its distance to the input.
     Simplify(simplify::Args),
@@ -43,17 +44,16 @@ enum Command {
     Reconstruct(reconstruct::Args),
     /// Refine a control mesh with a subdivision scheme (optionally to limit positions).
     Subdiv(subdiv::Args),
-    /// Fit a subdivision surface to a scan by geometric iteration.
+    /// Fit a subdivision surface (geometric iteration) or a B-spline surface to a scan.
     Fit(fit::Args),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse_from(fit_bspline::route(std::env::args_os().collect()));
+    let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => info::run(args),
         Command::FitCurve(args) => fit_curve::run(args),
         Command::ExportSamples(args) => export_samples::run(args),
-        Command::FitBspline(args) => fit_bspline::run(args),
         Command::Simplify(args) => simplify::run(args),
         Command::Reconstruct(args) => reconstruct::run(args),
         Command::Subdiv(args) => subdiv::run(args),
@@ -65,5 +65,18 @@ fn main() -> ExitCode {
             eprintln!("geofit: {}", message.replace('\n', " "));
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// clap checks its argument definitions (duplicate flags from flattened structs, bad
+    /// `requires`) only when asked: ask once here.
+    #[test]
+    fn command_line_definition_is_consistent() {
+        use clap::CommandFactory;
+        Cli::command().debug_assert();
     }
 }
