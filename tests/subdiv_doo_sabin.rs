@@ -21,9 +21,11 @@ fn refinement_uses_the_doo_sabin_weights_and_counts() {
     let mesh = jitter(&quad_grid(n, |x, y| x * y), 0.1, 1);
     let cm = ControlMesh::try_new(&mesh).unwrap();
     let r = refine(Scheme::DooSabin, &cm).unwrap();
-    // One new point per face corner; faces: one per face, interior edge and interior vertex.
-    assert_eq!(r.num_vertices(), 4 * n * n);
-    assert_eq!(r.num_faces(), n * n + 2 * n * (n - 1) + (n - 1) * (n - 1));
+    // One new point per face corner and two per boundary edge (Chaikin's points of the
+    // boundary polygon); faces: one per face, edge and vertex (the ghost ring makes boundary
+    // edges and vertices interior).
+    assert_eq!(r.num_vertices(), 4 * n * n + 2 * 4 * n);
+    assert_eq!(r.num_faces(), n * n + 2 * n * (n + 1) + (n + 1) * (n + 1));
     // Face 4 is the middle quad: its corner points are (9 a + 3 b + c + 3 d) / 16.
     let c: Vec<Point3> = cm
         .face_vertices(4)

@@ -9,7 +9,8 @@ use crate::mesh::ControlMesh;
 
 /// One refinement step of `scheme`. Loop needs triangles; Catmull–Clark and Doo–Sabin take any
 /// polygons. Boundary edges follow the curve rules (cubic B-spline for Loop and Catmull–Clark,
-/// Chaikin's quadratic for Doo–Sabin); sharp edges follow the crease rules and stay sharp.
+/// Chaikin's quadratic for Doo–Sabin, by its ghost ring); sharp edges follow the crease rules and
+/// stay sharp.
 pub fn refine(scheme: Scheme, mesh: &ControlMesh) -> Result<ControlMesh, SubdivError> {
     if scheme == Scheme::Loop {
         if let Some(f) = (0..mesh.num_faces() as u32).find(|&f| mesh.face_len(f) != 3) {
@@ -21,7 +22,10 @@ pub fn refine(scheme: Scheme, mesh: &ControlMesh) -> Result<ControlMesh, SubdivE
         }
     }
     let topo = topo_of(mesh);
-    let refined = topo.refine(scheme);
+    let refined = match scheme {
+        Scheme::DooSabin => super::doo_sabin::refine_control(&topo),
+        _ => topo.refine(scheme),
+    };
     let old = mesh.positions();
     let positions = refined
         .points
@@ -49,18 +53,25 @@ pub fn refine_levels(
 }
 
 /// Exact limit positions of the vertices of `mesh` under `scheme` (limit masks), without
-/// building an evaluator. For Doo–Sabin the limit point of an interior vertex is the centroid
-/// of its vertex face (kept by every step); boundary vertices give themselves.
+/// building an evaluator. For Doo–Sabin the limit point of a vertex is the centroid of its
+/// vertex face (kept by every step; at boundaries and creases the vertex face of the mesh with
+/// its ghost ring, see [`refine`]).
 pub fn limit_positions(scheme: Scheme, mesh: &ControlMesh) -> Result<Vec<Point3>, SubdivError> {
     let topo = topo_of(mesh);
     let p = mesh.positions();
-    (0..mesh.num_vertices() as u32)
-        .map(|v| {
-            let s = match scheme {
-                Scheme::DooSabin => super::doo_sabin::vertex_limit(&topo, v),
-                _ => topo.limit_stencil(scheme, v),
-            }
-            .ok_or(SubdivError::Unevaluable { patch: 0 })?;
+    let stencils: Vec<_> = match scheme {
+        Scheme::DooSabin => super::doo_sabin::vertex_limits(&topo)
+            .into_iter()
+            .map(Some)
+            .collect(),
+        _ => (0..mesh.num_vertices() as u32)
+            .map(|v| topo.limit_stencil(scheme, v))
+            .collect(),
+    };
+    stencils
+        .into_iter()
+        .map(|s| {
+            let s = s.ok_or(SubdivError::Unevaluable { patch: 0 })?;
             Ok(s.iter().map(|&(i, w)| p[i as usize] * w).sum())
         })
         .collect()

@@ -1,8 +1,9 @@
 //! [`SubdivSurface`]: the limit surface of a control mesh under one scheme, with everything
 //! topological precomputed so evaluation after moving control points is only weighted sums.
 
+use super::doo_sabin::{extend, limits_of, Extended};
 use super::patch::{neighbourhood, vertex_neighbourhood, Graph, Kind};
-use super::topo::{EdgeTag, Topo};
+use super::topo::{EdgeTag, Stencil, Topo, NO};
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::{ControlMesh, NONE};
@@ -27,8 +28,10 @@ pub struct SubdivSurface {
     graph: Graph,
     patches: Vec<Patch>,
     /// Face and vertex of each patch: the face itself for Loop and Catmull–Clark; for
-    /// Doo–Sabin the face corner at an interior vertex whose refined point the patch belongs to.
+    /// Doo–Sabin the face corner whose refined point the patch belongs to.
     sites: Vec<(u32, u32)>,
+    /// Doo–Sabin's extended mesh and patch sites.
+    doo_sabin: Option<Box<DooSabinSites>>,
     ctrl: Vec<u32>,
     /// Per patch, what evaluation needs from the current control points: power coefficients of
     /// direct patches, the shortcut data of the others. Refilled when control points move.
@@ -38,23 +41,62 @@ pub struct SubdivSurface {
     limit_weights: Vec<(u32, f64)>,
 }
 
-/// The (face, vertex) of every patch: one per face for the primal schemes; one per corner at
-/// an interior vertex for Doo–Sabin (its limit near open boundaries is not covered).
-fn patch_sites(scheme: Scheme, mesh: &ControlMesh, topo: &Topo) -> Vec<(u32, u32)> {
-    let mut sites = Vec::new();
-    for f in 0..mesh.num_faces() as u32 {
-        match scheme {
-            Scheme::DooSabin => {
-                for v in mesh.face_vertices(f) {
-                    if topo.is_complete(v) && !mesh.is_boundary_vertex(v) {
-                        sites.push((f, v));
-                    }
+/// The (face, first corner) of every patch of a primal scheme: one per face.
+fn primal_sites(mesh: &ControlMesh) -> Vec<(u32, u32)> {
+    (0..mesh.num_faces() as u32)
+        .map(|f| (f, mesh.face_vertices(f).next().unwrap_or(0)))
+        .collect()
+}
+
+/// Doo–Sabin's patches: one per corner of the extended mesh (control mesh with its ghost ring)
+/// at a vertex that is not a ghost copy, with what walking across patch edges needs.
+pub(crate) struct DooSabinSites {
+    /// The extended mesh.
+    pub ext: Extended,
+    /// (extended face, extended vertex) of every patch.
+    pub sites: Vec<(u32, u32)>,
+    /// Patch of every corner of the extended mesh (`NO` at ghost copies).
+    pub corner_patch: Vec<u32>,
+}
+
+impl DooSabinSites {
+    fn new(topo: &Topo) -> DooSabinSites {
+        let ext = extend(topo);
+        let t = &ext.topo;
+        let mut sites = Vec::new();
+        let mut corner_patch = vec![NO; t.face_verts.len()];
+        for f in 0..t.num_faces() as u32 {
+            let s = t.face_starts[f as usize] as usize;
+            for (i, &v) in t.face(f).iter().enumerate() {
+                if !ext.ghost[v as usize] {
+                    corner_patch[s + i] = sites.len() as u32;
+                    sites.push((f, v));
                 }
             }
-            _ => sites.push((f, mesh.face_vertices(f).next().unwrap_or(0))),
+        }
+        DooSabinSites {
+            ext,
+            sites,
+            corner_patch,
         }
     }
-    sites
+
+    /// (control face, control vertex) of every patch: a ghost face reports the control face on
+    /// whose cut edge it sits.
+    fn control_sites(&self) -> Vec<(u32, u32)> {
+        let e = &self.ext;
+        self.sites
+            .iter()
+            .map(|&(f, v)| {
+                let face = if (f as usize) < e.real_faces {
+                    f
+                } else {
+                    e.ghost_of[f as usize - e.real_faces]
+                };
+                (face, e.owner[v as usize])
+            })
+            .collect()
+    }
 }
 
 /// Builds the edge-tagged topology of a control mesh.
@@ -117,14 +159,30 @@ impl SubdivSurface {
         let topo = topo_of(&mesh);
         let mut patches = Vec::with_capacity(mesh.num_faces());
         let mut ctrl = Vec::new();
-        let sites = patch_sites(scheme, &mesh, &topo);
+        let doo_sabin = (scheme == Scheme::DooSabin).then(|| Box::new(DooSabinSites::new(&topo)));
+        let sites = match &doo_sabin {
+            Some(ds) => ds.control_sites(),
+            None => primal_sites(&mesh),
+        };
         let mut cache_len = 0;
-        for (patch, &(f, v)) in sites.iter().enumerate() {
-            let nb = match scheme {
-                Scheme::DooSabin => vertex_neighbourhood(&topo, v, f, Kind::DooSabinRoot),
-                _ => neighbourhood(&topo, f),
+        for patch in 0..sites.len() {
+            let (nb, source) = match &doo_sabin {
+                Some(ds) => {
+                    let (f, v) = ds.sites[patch];
+                    let nb = vertex_neighbourhood(&ds.ext.topo, v, f, Kind::DooSabinRoot);
+                    let source: Vec<u32> = nb
+                        .source
+                        .iter()
+                        .map(|&i| ds.ext.owner[i as usize])
+                        .collect();
+                    (nb, source)
+                }
+                None => {
+                    let nb = neighbourhood(&topo, sites[patch].0);
+                    let source = nb.source.clone();
+                    (nb, source)
+                }
             };
-            let source = nb.source.clone();
             let node = graph.add(nb, patch)?;
             let start = ctrl.len() as u32;
             let (picks, direct, shortcut, data) = match graph.direct_picks(node) {
@@ -146,13 +204,17 @@ impl SubdivSurface {
         }
         let mut limit_starts = vec![0u32];
         let mut limit_weights = Vec::new();
-        for v in 0..mesh.num_vertices() as u32 {
-            let s = match scheme {
-                Scheme::DooSabin => super::doo_sabin::vertex_limit(&topo, v),
-                _ => topo.limit_stencil(scheme, v),
-            }
-            .ok_or(SubdivError::Unevaluable { patch: 0 })?;
-            limit_weights.extend(s);
+        let stencils: Vec<Option<Stencil>> = match &doo_sabin {
+            Some(ds) => limits_of(&ds.ext, mesh.num_vertices())
+                .into_iter()
+                .map(Some)
+                .collect(),
+            None => (0..mesh.num_vertices() as u32)
+                .map(|v| topo.limit_stencil(scheme, v))
+                .collect(),
+        };
+        for s in stencils {
+            limit_weights.extend(s.ok_or(SubdivError::Unevaluable { patch: 0 })?);
             limit_starts.push(limit_weights.len() as u32);
         }
         let mut surface = SubdivSurface {
@@ -161,6 +223,7 @@ impl SubdivSurface {
             graph,
             patches,
             sites,
+            doo_sabin,
             ctrl,
             cache: Vec::with_capacity(cache_len),
             limit_starts,
@@ -190,7 +253,9 @@ impl SubdivSurface {
 
     /// The control face and vertex of `patch`: for Loop and Catmull–Clark the face (and its
     /// first corner); for Doo–Sabin the face corner at the vertex whose region the patch covers
-    /// (parameter (0, 0) is at the face's centroid, (1, 1) at the vertex's limit point).
+    /// (parameter (0, 0) is at the face's centroid, (1, 1) at the vertex's limit point). Doo–Sabin
+    /// patches between a face and a boundary or crease curve (two or three per vertex there) sit
+    /// on ghost faces (see [`refine`](super::refine)) and report the control face on that side.
     pub fn patch_site(&self, patch: u32) -> Option<(u32, u32)> {
         self.sites.get(patch as usize).copied()
     }
@@ -409,26 +474,9 @@ impl LimitSurface for SubdivSurface {
     }
 
     fn relocate(&self, patch: u32, u: f64, v: f64) -> SurfaceParam {
-        if self.scheme == Scheme::DooSabin {
-            // Doo–Sabin patches are clamped onto their own domain (no walking yet).
-            let clean = |x: f64| {
-                if x.is_finite() {
-                    x.clamp(0.0, 1.0)
-                } else {
-                    0.0
-                }
-            };
-            let patch = if (patch as usize) < self.patches.len() {
-                patch
-            } else {
-                0
-            };
-            return SurfaceParam {
-                patch,
-                u: clean(u),
-                v: clean(v),
-            };
+        match &self.doo_sabin {
+            Some(ds) => super::walk::walk_doo_sabin(ds, patch, u, v),
+            None => super::walk::relocate(&self.mesh, self.scheme, patch, u, v),
         }
-        super::walk::relocate(&self.mesh, self.scheme, patch, u, v)
     }
 }

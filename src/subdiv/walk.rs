@@ -2,6 +2,8 @@
 //! that holds the point, mapping parameters through the shared edge (neighbouring patches are
 //! unfolded into one plane across it), and clamp onto the domain at open boundaries.
 
+use super::surface::DooSabinSites;
+use super::topo::NO;
 use super::{Scheme, SurfaceParam};
 use crate::mesh::{ControlMesh, NONE};
 
@@ -117,4 +119,62 @@ fn walk_quads(mesh: &ControlMesh, mut f: u32, mut u: f64, mut v: f64) -> Surface
         u: u.clamp(0.0, 1.0),
         v: v.clamp(0.0, 1.0),
     }
+}
+
+/// Walks a Doo–Sabin parameter across patch edges. Patch (f, v) has corners (0, 0) at face f's
+/// centroid, (1, 0) and (0, 1) at the centroids of the faces of f's edges into and out of v,
+/// and (1, 1) at v: its sides lead to the patches (f, previous corner), (face across the
+/// incoming edge, v), (face across the outgoing edge, v) and (f, next corner), whose sides 3,
+/// 2, 1 and 0 run along the same curves in the opposite direction. Sides with no patch behind
+/// them (boundary and crease curves) clamp.
+pub(crate) fn walk_doo_sabin(ds: &DooSabinSites, patch: u32, u: f64, v: f64) -> SurfaceParam {
+    let clean = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let (mut u, mut v) = (clean(u), clean(v));
+    let mut p = if (patch as usize) < ds.sites.len() {
+        patch
+    } else {
+        0
+    };
+    for _ in 0..MAX_STEPS {
+        let out = [-v, u - 1.0, v - 1.0, -u];
+        let j = (0..4)
+            .max_by(|&a, &b| out[a].total_cmp(&out[b]))
+            .unwrap_or(0);
+        if out[j] <= 0.0 {
+            break;
+        }
+        let Some(q) = neighbour(ds, p, j) else {
+            break;
+        };
+        let (along, outward) = to_edge(j, u, v);
+        (u, v) = from_edge(3 - j, 1.0 - along, -outward);
+        p = q;
+    }
+    SurfaceParam {
+        patch: p,
+        u: u.clamp(0.0, 1.0),
+        v: v.clamp(0.0, 1.0),
+    }
+}
+
+/// The patch across side `j` of Doo–Sabin patch `p`, if there is one.
+fn neighbour(ds: &DooSabinSites, p: u32, j: usize) -> Option<u32> {
+    let t = &ds.ext.topo;
+    let (f, v) = *ds.sites.get(p as usize)?;
+    let corners = t.face(f);
+    let n = corners.len();
+    let i = t.corner_index(f, v)?;
+    let (inc, out) = t.corner_edges(f, v)?;
+    let (g, at) = match j {
+        0 => (f, corners[(i + n - 1) % n]),
+        3 => (f, corners[(i + 1) % n]),
+        1 => (t.other_face(inc, f), v),
+        _ => (t.other_face(out, f), v),
+    };
+    if g == NO {
+        return None;
+    }
+    let k = t.corner_index(g, at)?;
+    let q = ds.corner_patch[t.face_starts[g as usize] as usize + k];
+    (q != NO).then_some(q)
 }
