@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Benchmark of `geofit fit` on the Stanford bunny (SPEC §1, Table 1 model C): every weighting /
-# acceleration choice for Loop, then Catmull–Clark. Prints a Markdown table (one thread, release).
+# acceleration choice for Loop, then Catmull–Clark and Doo–Sabin. Prints a Markdown table (one thread, release).
 # Usage: bash scripts/bench_fit.sh [DATA_DIR]   (default: ../shared/data, else /work/shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +21,7 @@ run loop-basis-anderson --scheme loop --weights basis --accel anderson
 run loop-basis-none --scheme loop --weights basis --accel none
 run loop-patent-none --scheme loop --weights patent --accel none
 run cc-basis-cg --scheme catmull-clark --weights basis --accel cg
+run ds-basis-cg --scheme doo-sabin --weights basis --accel cg
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), load $(cut -d' ' -f1 /proc/loadavg)"
 echo
 echo "| run | converged | iterations | control points | E_avg % | E_max % | E_rms % | precompute s | fit s | total s |"
