@@ -193,8 +193,8 @@ export function createFitUi(host) {
   // Sent once per fit: the data points (in the order of the errors) and the initial control net.
   let once = null;
   // lastStats/history: the worker's latest figures; frames: frames shown; maxStageMs: the
-  // longest stage of showing one.
-  const state = { lastStats: null, history: [], frames: 0, maxStageMs: 0 };
+  // longest stage of showing one, stageMs: the longest of each stage.
+  const state = { lastStats: null, history: [], frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
   window.geofitFit = state;
 
   function options() {
@@ -377,7 +377,9 @@ export function createFitUi(host) {
     }
     const t0 = performance.now();
     STAGES[k](host.viewer(), m);
-    state.maxStageMs = Math.max(state.maxStageMs ?? 0, performance.now() - t0);
+    const ms = performance.now() - t0;
+    state.maxStageMs = Math.max(state.maxStageMs, ms);
+    state.stageMs[k] = Math.max(state.stageMs[k], ms);
     setTimeout(() => (k + 1 < STAGES.length ? showStage(m, k + 1) : showNewest()), 0);
   }
 

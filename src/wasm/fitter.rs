@@ -73,6 +73,25 @@ impl JsScheme {
 }
 
 impl JsFitOptions {
+    /// Reads the options object (`undefined` or `null`: all defaults). serde-wasm-bindgen reads
+    /// only the fields a struct declares, so the object's own names are checked separately: a
+    /// misspelt option is an error, not silently a default.
+    fn from_js(options: JsValue) -> Result<JsFitOptions, JsError> {
+        if options.is_undefined() || options.is_null() {
+            return Ok(JsFitOptions::default());
+        }
+        let bad = |e: &dyn std::fmt::Display| JsError::new(&format!("fit options: {e}"));
+        let names: std::collections::BTreeMap<String, serde::de::IgnoredAny> =
+            serde_wasm_bindgen::from_value(options.clone()).map_err(|e| bad(&e))?;
+        let nulls = names
+            .into_keys()
+            .map(|name| (name, serde_json::Value::Null))
+            .collect();
+        serde_json::from_value::<JsFitOptions>(serde_json::Value::Object(nulls))
+            .map_err(|e| bad(&e))?;
+        serde_wasm_bindgen::from_value(options).map_err(|e| bad(&e))
+    }
+
     fn scheme(&self) -> Result<JsScheme, JsError> {
         match self.scheme.as_deref().unwrap_or("loop") {
             "loop" => Ok(JsScheme::Subdiv(Scheme::Loop)),
@@ -368,12 +387,7 @@ impl Fitter {
     #[wasm_bindgen(constructor)]
     pub fn new(scan: &LoadedScan, options: JsValue) -> Result<Fitter, JsError> {
         let start = Instant::now();
-        let js: JsFitOptions = if options.is_undefined() || options.is_null() {
-            JsFitOptions::default()
-        } else {
-            serde_wasm_bindgen::from_value(options)
-                .map_err(|e| JsError::new(&format!("fit options: {e}")))?
-        };
+        let js = JsFitOptions::from_js(options)?;
         let fit = js.build(scan)?;
         let initial = MeshArrays::of(&fit.control_shape());
         Ok(Fitter {

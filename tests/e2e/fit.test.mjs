@@ -202,9 +202,10 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     const frames = await page.evaluate(() => window.geofitFit.frames);
     const longTasks = await page.evaluate(() => window.longTasks);
     const stage = await page.evaluate(() => window.geofitFit.maxStageMs);
+    const stages = await page.evaluate(() => window.geofitFit.stageMs.map((ms) => Math.round(ms)));
     console.log(`fit: ${stats.iter} iterations, ${stats.controlPoints} control points, E_max ${stats.eMaxPct} %, ` +
       `${seconds.toFixed(1)} s wall, ${(stats.totalMs / stats.iter).toFixed(1)} ms/iteration in the worker, ` +
-      `${frames} frames shown, longest stage of showing one ${stage.toFixed(1)} ms, long tasks ${JSON.stringify(longTasks)}`);
+      `${frames} frames shown, longest stage of showing one ${stage.toFixed(1)} ms (figures, points, surface, lines: ${stages.join(', ')} ms), long tasks ${JSON.stringify(longTasks)}`);
     const shownPct = Number(shown.split(' ')[0]);
     assert.ok(shownPct <= TOL_MAX, `displayed E_max ${shown}`);
     assert.equal(shown.split(' (')[0], `${stats.eMaxPct.toPrecision(4)} %`);
@@ -380,6 +381,48 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     } finally {
       await embed.close();
     }
+  });
+
+  test('the Fitter API throws Errors that name the problem', async () => {
+    const messages = await page.evaluate(async () => {
+      const m = await import(new URL('../pkg/geofit.js', location.href).href);
+      const load = async (file) => m.loadFile(new Uint8Array(await (await fetch(`samples/${file}`)).arrayBuffer()), file);
+      const caught = (f) => {
+        try {
+          f();
+          return 'no error';
+        } catch (e) {
+          return e instanceof Error ? e.message : `not an Error: ${e}`;
+        }
+      };
+      const mesh = await load('bunny.obj');
+      const cloud = await load('bun000-points.xyz');
+      const section = await load('bunny-section.xyz');
+      const curve = new m.Fitter(section, { scheme: 'chaikin-curve', closed: true, maxIter: 1 });
+      const loop = new m.Fitter(mesh, { initial: 200, maxIter: 1 });
+      const out = [
+        caught(() => new m.Fitter(mesh, { scheme: 'nurbs' })),
+        caught(() => new m.Fitter(mesh, { scheme: 'bspline-surface', method: 'newton' })),
+        caught(() => new m.Fitter(mesh, { tolerance: 1 })),
+        caught(() => new m.Fitter(mesh, { tolMax: -1 })),
+        caught(() => new m.Fitter(cloud, { scheme: 'loop' })),
+        caught(() => curve.exportObj()),
+        caught(() => loop.exportIges()),
+        caught(() => new m.Fitter(mesh, { scheme: 'bspline-surface', initial: 4, maxIter: 1 }).step()),
+        caught(() => new m.Fitter(mesh, { initial: 100 })),
+      ];
+      for (const x of [curve, loop, mesh, cloud, section]) x.free();
+      return out;
+    });
+    assert.match(messages[0], /option scheme: 'nurbs' is not one of/);
+    assert.match(messages[1], /option method: 'newton' is not one of/);
+    assert.match(messages[2], /fit options: unknown field `tolerance`/);
+    assert.match(messages[3], /tol/);
+    assert.match(messages[4], /no faces/);
+    assert.match(messages[5], /a curve has no surface to export as a mesh/);
+    assert.match(messages[6], /IGES and STEP export a B-spline/);
+    assert.doesNotMatch(messages[7], /not an Error/);
+    assert.match(messages[8], /simplification: cannot go below \d+ vertices \(target 100\)/);
   });
 
   test('keyboard: arrow keys turn the focused view; every control has a label', async () => {
