@@ -17,6 +17,7 @@ pub mod options;
 pub mod parameterize;
 pub mod patches;
 pub mod refine;
+pub mod refine_ds;
 pub mod refine_quad;
 pub mod report;
 mod scheme;

@@ -2,12 +2,13 @@
 //! with each scheme's refinement and remeshing.
 
 use super::refine::{improve_by_flips, split_triangles, SplitRule};
+use super::refine_ds::split_polygons;
 use super::refine_quad::split_quads;
 use super::subdiv::{ControlSurface, SubdivFitter};
 use super::{FitError, SubdivFitOptions};
 use crate::geom::Point3;
 use crate::mesh::{ControlMesh, PolyMesh};
-use crate::subdiv::{quadrangulate, refine, Scheme, SubdivSurface};
+use crate::subdiv::{quadrangulate, Scheme, SubdivSurface};
 
 /// The limit surface of `control` under `scheme`; quad schemes accept any polygon mesh and turn
 /// it into quads first (one Catmull–Clark step) when it is not all quads.
@@ -26,6 +27,9 @@ fn control_mesh_of(scheme: Scheme, control: &PolyMesh) -> Result<ControlMesh, Fi
     Ok(match scheme {
         Scheme::Loop => mesh,
         _ if mesh.is_quad_mesh() => mesh,
+        // Doo–Sabin takes any polygons; only an all-triangle start is turned into quads (its
+        // local refinements add quads and (n + 1)-gons, which must stay as they are).
+        Scheme::DooSabin if !mesh.is_triangle_mesh() => mesh,
         _ => quadrangulate(&mesh)?,
     })
 }
@@ -48,33 +52,24 @@ impl ControlSurface for SubdivSurface {
     }
 
     /// Loop and Catmull–Clark patches are the control faces. Doo–Sabin patches sit at
-    /// (face, vertex) sites whose face the surface does not expose, so they report no face
-    /// (`usize::MAX`): Doo–Sabin fits run without refinement.
+    /// (face, vertex) sites and belong to that face.
     fn patch_face(&self, patch: u32) -> usize {
         match self.scheme() {
-            Scheme::DooSabin => usize::MAX,
+            Scheme::DooSabin => self
+                .patch_site(patch)
+                .map_or(usize::MAX, |(f, _)| f as usize),
             _ => patch as usize,
         }
     }
 
     /// Loop: red–green splitting with Loop's masks. Catmull–Clark: local conforming quad
-    /// splitting with transition templates and Catmull–Clark's masks. Doo–Sabin: one
-    /// refinement step of the whole mesh (it reproduces the limit surface exactly), made only
-    /// when it fits the caller's budget.
+    /// splitting with transition templates and Catmull–Clark's masks. Doo–Sabin: marked
+    /// faces split into quads around their centroids, neighbours gain the edge midpoints.
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
         match self.scheme() {
             Scheme::Loop => split_triangles(control, marked, SplitRule::Loop),
             Scheme::CatmullClark => split_quads(control, marked),
-            Scheme::DooSabin => {
-                let mesh = ControlMesh::try_new(control).map_err(|e| FitError::ControlMesh {
-                    reason: e.to_string(),
-                })?;
-                refine(Scheme::DooSabin, &mesh)?
-                    .to_poly_mesh()
-                    .map_err(|e| FitError::ControlMesh {
-                        reason: e.to_string(),
-                    })
-            }
+            Scheme::DooSabin => split_polygons(control, marked),
         }
     }
 
