@@ -91,6 +91,12 @@ fn degenerate_inputs_give_clear_errors() {
         reconstruct(&line, None, &o),
         Err(ReconstructError::Degenerate { what: "collinear" })
     ));
+    // Off the axes, the rounding of the eigenvalues must not pass for a width.
+    let diagonal: Vec<Point3> = (0..20).map(|i| Point3::splat(i as f64)).collect();
+    assert!(matches!(
+        reconstruct(&diagonal, None, &o),
+        Err(ReconstructError::Degenerate { what: "collinear" })
+    ));
     let same = vec![p(1.0, 2.0, 3.0); 10];
     assert!(matches!(
         reconstruct(&same, None, &o),

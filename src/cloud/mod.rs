@@ -11,8 +11,9 @@
 //!   local point spacing) are cut away. The mesh's vertices are the input points themselves.
 //! - **Closed** objects (points all around): normals by PCA over the k nearest neighbours,
 //!   oriented consistently along a minimum spanning tree (Hoppe et al. 1992), then the zero set
-//!   of an implicit moving-least-squares signed distance contoured by marching tetrahedra: a
-//!   watertight manifold wherever the sampling is closed. Its vertices are new points.
+//!   of an implicit moving-least-squares signed distance contoured by marching tetrahedra (its
+//!   slivers collapsed): a watertight manifold wherever the sampling is closed. Its vertices
+//!   are new points.
 //!
 //! Either way the result is one manifold, consistently oriented piece; for fitting, keep the
 //! input points as the data and use the mesh only to start from (e.g. through
@@ -47,6 +48,7 @@ pub use error::ReconstructError;
 
 use crate::geom::{Point3, Vec3};
 use crate::io::RangeGrid;
+use crate::mesh::simplify::{simplify_with, SimplifyOptions};
 use crate::mesh::PolyMesh;
 use neighbours::{median, Neighbours};
 
@@ -157,6 +159,8 @@ pub struct Reconstruction {
     pub kind: SurfaceKind,
     /// Points removed as outliers.
     pub outliers: usize,
+    /// Per input point: whether it survived outlier removal (all `true` without it).
+    pub inlier: Vec<bool>,
 }
 
 /// Neighbours for spacing estimates and the outlier test.
@@ -167,6 +171,8 @@ const MIN_POINTS: usize = 4;
 const OPEN_FRACTION: f64 = 0.9;
 /// Closed contour: cells within this many cells of a point are evaluated.
 const BAND_CELLS: i32 = 2;
+/// Closed contour: sliver removal keeps one vertex in this many.
+const SLIVER_REDUCTION: usize = 2;
 
 /// Builds a manifold triangle mesh from `points`, using the scanner `grid` (indices into
 /// `points`) when there is one. See the [module docs](self).
@@ -207,12 +213,19 @@ pub fn reconstruct(
             what: "all at one place",
         });
     }
-    if frame.values[1].max(0.0).sqrt() <= 1e-9 * extent {
+    // The eigenvalues carry rounding of about 1e-16 of the largest, so a line off the axes
+    // shows a width of about 1e-8 of its length: anything thinner than 1e-6 is a line.
+    if frame.values[1].max(0.0).sqrt() <= 1e-6 * extent {
         return Err(ReconstructError::Degenerate { what: "collinear" });
     }
-    // Oriented normals of the kept points: needed to tell the kinds apart and for closed ones.
-    let oriented = (grid.is_none() && options.kind != Some(SurfaceKind::Open))
-        .then(|| oriented_normals(&kept, &frame, options.neighbours));
+    // Oriented normals of the kept points: needed to tell the kinds apart (a range grid means
+    // open) and for closed surfaces.
+    let oriented = match options.kind {
+        Some(SurfaceKind::Open) => false,
+        Some(_) => true,
+        None => grid.is_none(),
+    }
+    .then(|| oriented_normals(&kept, &frame, options.neighbours));
     let kind = match (options.kind, &oriented) {
         (Some(kind), _) => kind,
         (None, Some((_, normals))) => detect_kind(normals, &frame),
@@ -228,6 +241,7 @@ pub fn reconstruct(
         mesh,
         kind,
         outliers,
+        inlier,
     })
 }
 
@@ -310,7 +324,20 @@ fn closed_mesh(
         return Err(ReconstructError::NoSurface);
     }
     let (positions, tris) = compact(positions, tris);
-    PolyMesh::try_new(positions, tris).map_err(|_| ReconstructError::NoSurface)
+    let mesh = PolyMesh::try_new(positions, tris).map_err(|_| ReconstructError::NoSurface)?;
+    Ok(without_slivers(mesh))
+}
+
+/// `mesh` with the slivers marching tetrahedra leaves (contour vertices a hair apart where the
+/// surface passes near a grid corner) collapsed: a QEM simplification to half the vertices
+/// with no triangle-quality limit, whose cheapest collapses are exactly those short edges. A
+/// later QEM to a control mesh with its quality limit is then no longer hemmed in by them (on
+/// the bunny's vertices → 612: the points' rms distance to the control mesh drops from 0.75 %
+/// to 0.47 % of the diagonal, as from the original mesh). Kept as is if that fails (tiny
+/// meshes).
+fn without_slivers(mesh: PolyMesh) -> PolyMesh {
+    let options = SimplifyOptions::default().with_min_triangle_quality(0.0);
+    simplify_with(&mesh, mesh.num_vertices() / SLIVER_REDUCTION, &options).unwrap_or(mesh)
 }
 
 /// Drops vertices in no triangle, renumbering the rest in order.

@@ -1,9 +1,15 @@
 //! Building a subdivision fitter from a loaded data file: the one path the command line and the
-//! wasm API share (initial control mesh by QEM simplification, scheme set-up, fitter).
+//! wasm API share (a mesh for bare points, initial control mesh by QEM simplification, scheme
+//! set-up, fitter).
 
 use super::{FitError, SubdivFitOptions, SubdivFitter};
+use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
+use crate::geom::Point3;
+use crate::io::RangeGrid;
 use crate::mesh::PolyMesh;
 use crate::subdiv::{Scheme, SubdivSurface};
+use serde::Serialize;
+use web_time::Instant;
 
 /// The initial control-mesh size for `n` data points when the user gives none: n/60 (at least
 /// 50, at most 20,000, never more than the `used` vertices of the data mesh), a density at which
@@ -13,11 +19,12 @@ pub fn default_initial_count(n: usize, used: usize) -> usize {
 }
 
 /// The data mesh simplified by QEM to `target` vertices (or [`default_initial_count`]).
-/// A point cloud has no faces to simplify: the caller must supply a control mesh.
+/// A point cloud has no faces to simplify: reconstruct a mesh first (as
+/// [`build_subdiv_fitter`] does).
 pub fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<PolyMesh, FitError> {
     if data.is_point_cloud() {
         return Err(FitError::ControlMesh {
-            reason: "the data has no faces; give a control mesh".into(),
+            reason: "the data has no faces; reconstruct a mesh from the points first".into(),
         });
     }
     let used = used_vertices(data);
@@ -27,21 +34,99 @@ pub fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<PolyMes
     })
 }
 
-/// A fitter of every vertex of `data` by the limit surface of `scheme`, starting from `control`
-/// when given, else from the data simplified to `initial` vertices.
+/// What [`build_subdiv_fitter`] made of bare points before simplifying: goes into the fit
+/// report as `reconstruction`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ReconstructionReport {
+    /// `open` or `closed`.
+    pub kind: &'static str,
+    /// `range-grid`, `delaunay` (open scans) or `implicit` (closed objects).
+    pub method: &'static str,
+    /// Points removed as outliers (they are not fitted either).
+    pub outliers: usize,
+    /// Vertices of the reconstructed mesh.
+    pub vertices: usize,
+    /// Triangles of the reconstructed mesh.
+    pub triangles: usize,
+    /// Seconds the reconstruction took (included in the report's `precompute_s`).
+    pub seconds: f64,
+}
+
+/// A fitter ready to iterate, with what was reconstructed on the way (for point clouds).
+pub struct SubdivSetup {
+    /// The fitter.
+    pub fitter: SubdivFitter<SubdivSurface>,
+    /// `Some` when the data had no faces and a mesh was reconstructed from the points.
+    pub reconstruction: Option<ReconstructionReport>,
+}
+
+/// A fitter of the data points by the limit surface of `scheme`, starting from `control` when
+/// given, else from a QEM simplification to `initial` vertices of the data mesh.
+///
+/// Data with faces is simplified as it is. Bare points (no faces) are first reconstructed
+/// into a mesh by [`crate::cloud::reconstruct`] with `cloud` (open or closed, outlier
+/// removal), using the scanner's `grid` when there is one; the fit then runs on the original
+/// points (less those removed as outliers), not on the reconstructed vertices.
 pub fn build_subdiv_fitter(
     data: &PolyMesh,
+    grid: Option<&RangeGrid>,
+    cloud: &ReconstructOptions,
     scheme: Scheme,
     control: Option<PolyMesh>,
     initial: Option<usize>,
     options: SubdivFitOptions,
-) -> Result<SubdivFitter<SubdivSurface>, FitError> {
+) -> Result<SubdivSetup, FitError> {
     options.validate()?;
+    if !data.is_point_cloud() {
+        let control = match control {
+            Some(mesh) => mesh,
+            None => initial_control(data, initial)?,
+        };
+        let fitter = SubdivFitter::try_new(data.positions(), control, scheme, options)?;
+        return Ok(SubdivSetup {
+            fitter,
+            reconstruction: None,
+        });
+    }
+    let (points, mesh, report) = reconstruct_cloud(data.positions(), grid, cloud)?;
     let control = match control {
         Some(mesh) => mesh,
-        None => initial_control(data, initial)?,
+        None => initial_control(&mesh, initial)?,
     };
-    SubdivFitter::try_new(data.positions(), control, scheme, options)
+    let fitter = SubdivFitter::try_new(&points, control, scheme, options)?;
+    Ok(SubdivSetup {
+        fitter,
+        reconstruction: Some(report),
+    })
+}
+
+/// The points to fit (outliers dropped), the mesh reconstructed from them and its report.
+fn reconstruct_cloud(
+    points: &[Point3],
+    grid: Option<&RangeGrid>,
+    options: &ReconstructOptions,
+) -> Result<(Vec<Point3>, PolyMesh, ReconstructionReport), FitError> {
+    let start = Instant::now();
+    let rec = reconstruct(points, grid, options)?;
+    let kept: Vec<Point3> = points
+        .iter()
+        .zip(&rec.inlier)
+        .filter_map(|(p, &k)| k.then_some(*p))
+        .collect();
+    let (kind, method) = match (rec.kind, grid) {
+        (SurfaceKind::Closed, _) => ("closed", "implicit"),
+        (_, Some(_)) => ("open", "range-grid"),
+        (_, None) => ("open", "delaunay"),
+    };
+    let report = ReconstructionReport {
+        kind,
+        method,
+        outliers: rec.outliers,
+        vertices: used_vertices(&rec.mesh),
+        triangles: rec.mesh.num_triangles(),
+        seconds: start.elapsed().as_secs_f64(),
+    };
+    Ok((kept, rec.mesh, report))
 }
 
 /// How many vertices of `mesh` some face uses.

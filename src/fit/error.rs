@@ -39,6 +39,9 @@ pub enum FitError {
         /// Index of the repeated point in the input.
         index: usize,
     },
+    /// Bare points could not be turned into a mesh to start from.
+    #[error("reconstructing a surface from the points: {0}")]
+    Reconstruct(#[from] crate::cloud::ReconstructError),
     /// The spline could not be built (degree out of range, bad knots).
     #[error(transparent)]
     Spline(#[from] crate::spline::SplineError),

@@ -25,7 +25,9 @@ mod stats;
 pub mod subdiv;
 
 pub use bspline_surface::{GeometricSurfaceFitter, GeometricSurfaceOptions};
-pub use build::{build_subdiv_fitter, default_initial_count, initial_control};
+pub use build::{
+    build_subdiv_fitter, default_initial_count, initial_control, ReconstructionReport, SubdivSetup,
+};
 pub use closest::FootPoint;
 pub use curve::{CurveFitOptions, CurveFitter};
 pub use curve_lsq::least_squares_curve;
@@ -35,7 +37,7 @@ pub use lsq_surface::{LsqSurfaceFitter, LsqSurfaceOptions};
 pub use options::{Acceleration, SubdivFitOptions, Weighting};
 pub use parameterize::{FoldPolicy, ParamOptions, Parameterization};
 pub use patches::TolMode;
-pub use report::FitReport;
+pub use report::{within_tolerance_pct, FitReport};
 pub use scheme::surface_of;
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
 pub use subdiv::{ControlSurface, SubdivFitter};

@@ -242,6 +242,8 @@ impl Fit {
             e_max_pct: stats.e_max_pct,
             e_rms_pct: stats.e_rms_pct,
             converged: self.status() == FitStatus::Converged,
+            within_tolerance_pct: None,
+            reconstruction: None,
             precompute_s: setup_s,
             fit_s,
             total_s: setup_s + fit_s,

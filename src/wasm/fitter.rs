@@ -4,6 +4,7 @@
 
 use super::engine::{Engine, Fit, Shape};
 use super::scan::LoadedScan;
+use crate::cloud::{ReconstructOptions, SurfaceKind};
 use crate::fit::{
     build_subdiv_fitter, Acceleration, CurveFitOptions, CurveFitter, FitStatus,
     GeometricSurfaceFitter, GeometricSurfaceOptions, IterationRecord, LsqSurfaceFitter,
@@ -47,6 +48,12 @@ struct JsFitOptions {
     weights: Option<String>,
     /// 'none' | 'relax' | 'anderson' | 'cg' [cg with basis weights, none with patent weights].
     acceleration: Option<String>,
+    /// Subdivision schemes, point files without faces: 'auto' | 'open' | 'closed' surface to
+    /// reconstruct before simplifying [auto].
+    cloud: Option<String>,
+    /// Subdivision schemes, point files without faces: statistical outlier removal, standard
+    /// deviations [off].
+    outliers: Option<f64>,
 }
 
 /// What the `scheme` option names.
@@ -225,13 +232,39 @@ impl JsFitOptions {
         Ok(Engine::Curve(Box::new(CurveFitter::try_new(&points, o)?)))
     }
 
+    /// How bare points become a mesh for the subdivision schemes; ranges are checked by the
+    /// reconstruction.
+    fn cloud(&self) -> Result<ReconstructOptions, JsError> {
+        let kind = match self.cloud.as_deref().unwrap_or("auto") {
+            "auto" => None,
+            "open" => Some(SurfaceKind::Open),
+            "closed" => Some(SurfaceKind::Closed),
+            other => {
+                return Err(JsError::new(&format!(
+                    "option cloud: '{other}' is not one of 'auto', 'open', 'closed'"
+                )))
+            }
+        };
+        Ok(ReconstructOptions::default()
+            .with_kind(kind)
+            .with_outlier_std_ratio(self.outliers))
+    }
+
     /// The engine of the chosen scheme, fitting `scan`.
     fn build(&self, scan: &LoadedScan) -> Result<Fit, JsError> {
         let scheme = self.scheme()?;
         let engine = match scheme {
             JsScheme::Subdiv(s) => {
-                let f = build_subdiv_fitter(scan.mesh(), s, None, self.initial, self.to_core()?)?;
-                Engine::Subdiv(Box::new(f))
+                let setup = build_subdiv_fitter(
+                    scan.mesh(),
+                    scan.range_grid(),
+                    &self.cloud()?,
+                    s,
+                    None,
+                    self.initial,
+                    self.to_core()?,
+                )?;
+                Engine::Subdiv(Box::new(setup.fitter))
             }
             JsScheme::BsplineSurface => self.surface_engine(scan.mesh().positions())?,
             JsScheme::BsplineCurve => self.curve_engine(scan, 3)?,
@@ -370,7 +403,8 @@ impl MeshArrays {
 /// a B-spline / Chaikin curve (for ordered section data).
 ///
 /// `new Fitter(scan, {scheme, method, closed, tolAvg, tolMax, tolRms, initial, maxIter, refine,
-/// maxControl, weights, acceleration})` builds the initial control net and the first foot points;
+/// maxControl, weights, acceleration, cloud, outliers})` builds the initial control net (bare
+/// points are first reconstructed into a mesh for the subdivision schemes) and the first foot points;
 /// then `step()` or `run(budgetMs)` iterate. Tolerances are % of the bounding-box diagonal.
 #[wasm_bindgen]
 pub struct Fitter {

@@ -41,6 +41,11 @@ impl LoadedScan {
             .collect();
         (points, closed)
     }
+
+    /// The scanner grid of a raw range scan, if the file has one.
+    pub(crate) fn range_grid(&self) -> Option<&io::RangeGrid> {
+        self.file.range_grid.as_ref()
+    }
 }
 
 #[wasm_bindgen]

@@ -3,12 +3,13 @@
 //! the control mesh and the limit surface.
 
 use clap::ValueEnum;
+use geofit::cloud::{ReconstructOptions, SurfaceKind};
 use geofit::fit::{
-    build_subdiv_fitter, Acceleration, FitReport, FitStatus, Fitter, SubdivFitOptions,
-    SubdivFitter, Tolerances, Weighting,
+    build_subdiv_fitter, Acceleration, FitReport, FitStatus, Fitter, SubdivFitOptions, SubdivSetup,
+    Tolerances, Weighting,
 };
 use geofit::mesh::PolyMesh;
-use geofit::subdiv::{Scheme, SubdivSurface};
+use geofit::subdiv::Scheme;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -48,12 +49,23 @@ pub enum AccelArg {
     Cg,
 }
 
+/// How a point file without faces is turned into a mesh to start from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CloudArg {
+    /// Decide from the data (a range grid, or normals mostly facing one side, mean open).
+    Auto,
+    /// An open single-view scan: range grid or Delaunay on the best-fit plane.
+    Open,
+    /// A closed object: oriented normals and an implicit surface.
+    Closed,
+}
+
 /// Arguments of `geofit fit`.
 #[derive(clap::Args)]
 #[command(after_help = "\
 Without --initial the initial control mesh has n/60 vertices for n data points (at least 50, at \
 most 20,000, and never more than the data mesh has), a density at which QEM keeps the shape of \
-scans like the Stanford bunny (35,947 points -> 599). Tolerances are % of the data's bounding-box \
+scans like the Stanford bunny (35,947 points -> 599). Point files without faces are first reconstructed into a mesh (see --cloud, --outliers; as `geofit reconstruct`), which QEM then simplifies; the fit runs on the original points. Tolerances are % of the data's bounding-box \
 diagonal; a fit stops when every tolerance given is met (with none given: --tol-avg 0.01 \
 --tol-max 0.05) or after --max-iter iterations.")]
 pub struct Args {
@@ -68,6 +80,17 @@ pub struct Args {
     /// Start from this control mesh instead of simplifying the data.
     #[arg(long)]
     control: Option<PathBuf>,
+    /// Point files without faces: the kind of surface to reconstruct before simplifying.
+    #[arg(long, value_enum, default_value = "auto")]
+    cloud: CloudArg,
+    /// Point files without faces: statistical outlier removal, dropping points whose mean
+    /// neighbour distance is this many standard deviations above the mean (they are not
+    /// fitted either).
+    #[arg(long, alias = "remove-outliers")]
+    outliers: Option<f64>,
+    /// Point files without faces: ignore the file's range grid (triangulate by Delaunay).
+    #[arg(long)]
+    no_grid: bool,
     /// Tolerance on E_avg, % of the bounding-box diagonal.
     #[arg(long)]
     tol_avg: Option<f64>,
@@ -157,6 +180,16 @@ impl Args {
         options.refine_growth = self.refine_growth;
         options
     }
+
+    fn cloud(&self) -> ReconstructOptions {
+        ReconstructOptions::default()
+            .with_kind(match self.cloud {
+                CloudArg::Auto => None,
+                CloudArg::Open => Some(SurfaceKind::Open),
+                CloudArg::Closed => Some(SurfaceKind::Closed),
+            })
+            .with_outlier_std_ratio(self.outliers)
+    }
 }
 
 fn read(path: &Path) -> Result<PolyMesh, String> {
@@ -176,13 +209,25 @@ pub fn run(args: Args) -> Result<(), String> {
         return Err(format!("{flag} applies to --scheme bspline only"));
     }
     let start = Instant::now();
-    let data = read(&args.file)?;
+    let file =
+        geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
     let control = args.control.as_deref().map(read).transpose()?;
-    let fitter = build_subdiv_fitter(&data, scheme, control, args.initial, args.options())
-        .map_err(|e| e.to_string())?;
-    // Reading and QEM count as precompute; the report adds the fitter's own set-up time.
-    let before_fitter = (start.elapsed().as_secs_f64() - fitter.precompute_seconds()).max(0.0);
-    drive(fitter, before_fitter, &args)
+    let grid = file.range_grid.as_ref().filter(|_| !args.no_grid);
+    let setup = build_subdiv_fitter(
+        &file.mesh,
+        grid,
+        &args.cloud(),
+        scheme,
+        control,
+        args.initial,
+        args.options(),
+    )
+    .map_err(|e| format!("{}: {e}", args.file.display()))?;
+    // Reading, reconstruction and QEM count as precompute; the report adds the fitter's own
+    // set-up time.
+    let before_fitter =
+        (start.elapsed().as_secs_f64() - setup.fitter.precompute_seconds()).max(0.0);
+    drive(setup, before_fitter, &args)
 }
 
 /// The `--scheme bspline` branch: the shared options that apply, then the B-spline fit.
@@ -209,11 +254,17 @@ fn run_bspline(args: &Args) -> Result<(), String> {
 }
 
 /// Iterates to the end, printing progress, then writes the outputs.
-fn drive(
-    mut fitter: SubdivFitter<SubdivSurface>,
-    before_fitter: f64,
-    args: &Args,
-) -> Result<(), String> {
+fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), String> {
+    let SubdivSetup {
+        mut fitter,
+        reconstruction,
+    } = setup;
+    if let (false, Some(r)) = (args.quiet, &reconstruction) {
+        println!(
+            "reconstructed {} surface ({}): {} triangles, {} outliers removed, {:.3} s",
+            r.kind, r.method, r.triangles, r.outliers, r.seconds
+        );
+    }
     let s = fitter.stats();
     if !args.quiet {
         println!(
@@ -245,9 +296,13 @@ fn drive(
             break;
         }
     }
-    let report = FitReport::of(&fitter, before_fitter, fit_start.elapsed().as_secs_f64());
+    let mut report = FitReport::of(&fitter, before_fitter, fit_start.elapsed().as_secs_f64());
+    report.reconstruction = reconstruction;
+    let within = report.within_tolerance_pct.map_or(String::new(), |w| {
+        format!(" ({w:.2}% of points within E_max tolerance)")
+    });
     println!(
-        "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%, precompute {:.2} s, fit {:.2} s, total {:.2} s",
+        "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%{}, precompute {:.2} s, fit {:.2} s, total {:.2} s",
         report.scheme,
         if report.converged { "converged" } else { "stopped" },
         report.iterations,
@@ -256,6 +311,7 @@ fn drive(
         report.e_avg_pct,
         report.e_max_pct,
         report.e_rms_pct,
+        within,
         report.precompute_s,
         report.fit_s,
         report.total_s

@@ -6,8 +6,8 @@
 
 use geofit::export::{iges::write_iges, step::write_step, ExportModel, SurfaceDesc};
 use geofit::fit::{
-    FitReport, FitStatus, Fitter, FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions,
-    LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, TolMode,
+    within_tolerance_pct, FitReport, FitStatus, Fitter, FoldPolicy, GeometricSurfaceFitter,
+    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, TolMode,
 };
 use geofit::geom::Vec3;
 use geofit::spline::BSplineSurface;
@@ -221,6 +221,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
                 fitter.initial_control_points(),
                 pre,
                 fit_s,
+                args.tol_max,
             );
             (
                 report_of(base, "least-squares", fitter.surface(), fitter.num_folded()),
@@ -249,6 +250,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
                 fitter.initial_control_points(),
                 pre,
                 fit_s,
+                args.tol_max,
             );
             (
                 report_of(base, "geometric", fitter.surface(), fitter.num_folded()),
@@ -313,8 +315,15 @@ fn base_report<F: Fitter>(
     initial: usize,
     precompute_s: f64,
     fit_s: f64,
+    tol_pct: f64,
 ) -> FitReport {
     let stats = fitter.stats();
+    // The fitter's own diagonal, from its E_max in model units and in %.
+    let diagonal = if stats.e_max_pct > 0.0 {
+        100.0 * stats.e_max / stats.e_max_pct
+    } else {
+        0.0
+    };
     FitReport {
         scheme: "bspline".into(),
         points,
@@ -328,6 +337,12 @@ fn base_report<F: Fitter>(
         e_max_pct: stats.e_max_pct,
         e_rms_pct: stats.e_rms_pct,
         converged: status == FitStatus::Converged,
+        within_tolerance_pct: Some(within_tolerance_pct(
+            fitter.point_errors(),
+            diagonal,
+            tol_pct,
+        )),
+        reconstruction: None,
         precompute_s,
         fit_s,
         total_s: precompute_s + fit_s,

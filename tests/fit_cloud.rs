@@ -1,0 +1,257 @@
+//! Fitting bare point clouds end to end: points without faces are reconstructed into a mesh
+//! (open or closed), simplified by QEM and fitted, through the library entry point
+//! `build_subdiv_fitter` and through `geofit fit`; degenerate clouds give clear errors.
+
+mod common;
+
+use common::Rng;
+use geofit::cloud::ReconstructOptions;
+use geofit::fit::{
+    build_subdiv_fitter, FitError, FitReport, FitStatus, Fitter, SubdivFitOptions, Tolerances,
+};
+use geofit::geom::Point3;
+use geofit::mesh::PolyMesh;
+use geofit::subdiv::Scheme;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// `n` points spread evenly (Fibonacci spiral) over an ellipsoid with half-axes 1, 0.8, 0.6.
+fn ellipsoid(n: usize) -> Vec<Point3> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).sqrt();
+            let a = golden * i as f64;
+            Point3::new(r * a.cos(), 0.8 * r * a.sin(), 0.6 * z)
+        })
+        .collect()
+}
+
+/// A noisy wavy height field over a 40 × 40 grid (jittered), plus two stray points far above.
+fn noisy_sheet() -> Vec<Point3> {
+    let mut rng = Rng(7);
+    let mut points: Vec<Point3> = (0..1600)
+        .map(|k| {
+            let x = (k % 40) as f64 + 0.3 * rng.next_f64();
+            let y = (k / 40) as f64 + 0.3 * rng.next_f64();
+            let z = 2.0 * (x / 8.0).sin() * (y / 10.0).cos() + 0.02 * (rng.next_f64() - 0.5);
+            Point3::new(x, y, z)
+        })
+        .collect();
+    points.push(Point3::new(20.0, 20.0, 30.0));
+    points.push(Point3::new(5.0, 30.0, -25.0));
+    points
+}
+
+fn options(avg: f64, max: f64) -> SubdivFitOptions {
+    SubdivFitOptions::default()
+        .with_tolerances(Tolerances {
+            avg_pct: Some(avg),
+            max_pct: Some(max),
+            rms_pct: None,
+        })
+        .with_max_iter(40)
+        .with_max_control(Some(1_000))
+}
+
+#[test]
+fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
+    let mut points = ellipsoid(2_000);
+    // Every tenth point twice: duplicates must not disturb normals or the fit.
+    let twice: Vec<Point3> = points.iter().step_by(10).copied().collect();
+    points.extend(twice);
+    let data = PolyMesh::from_points(points.clone()).expect("finite points");
+    let setup = build_subdiv_fitter(
+        &data,
+        None,
+        &ReconstructOptions::default(),
+        Scheme::Loop,
+        None,
+        Some(80),
+        options(0.05, 0.3),
+    )
+    .expect("a fitter");
+    let rec = setup.reconstruction.clone().expect("reconstructed");
+    assert_eq!((rec.kind, rec.method), ("closed", "implicit"));
+    assert!(rec.triangles > 500, "{rec:?}");
+    let mut fitter = setup.fitter;
+    assert_eq!(
+        fitter.data().len(),
+        points.len(),
+        "the original points are fitted"
+    );
+    assert_eq!(fitter.num_control_points(), 80);
+    let status = fitter.run().expect("iterates");
+    let stats = fitter.stats();
+    assert_eq!(status, FitStatus::Converged, "{stats:?}");
+    assert!(
+        stats.e_avg_pct <= 0.05 && stats.e_max_pct <= 0.3,
+        "{stats:?}"
+    );
+    let report = FitReport::of(&fitter, 0.0, 0.0);
+    assert_eq!(report.within_tolerance_pct, Some(100.0));
+}
+
+#[test]
+fn open_noisy_cloud_drops_outliers_and_reports_the_share_within_tolerance() {
+    let points = noisy_sheet();
+    let data = PolyMesh::from_points(points.clone()).expect("finite points");
+    let cloud = ReconstructOptions::default().with_outlier_std_ratio(Some(3.0));
+    let setup = build_subdiv_fitter(
+        &data,
+        None,
+        &cloud,
+        Scheme::Loop,
+        None,
+        None,
+        options(0.1, 0.5),
+    )
+    .expect("a fitter");
+    let rec = setup.reconstruction.clone().expect("reconstructed");
+    assert_eq!((rec.kind, rec.method), ("open", "delaunay"));
+    assert_eq!(rec.outliers, 2, "{rec:?}");
+    let mut fitter = setup.fitter;
+    assert_eq!(
+        fitter.data().len(),
+        points.len() - 2,
+        "outliers are not fitted"
+    );
+    let status = fitter.run().expect("iterates");
+    assert_eq!(status, FitStatus::Converged, "{:?}", fitter.stats());
+    let within = FitReport::of(&fitter, 0.0, 0.0)
+        .within_tolerance_pct
+        .expect("an E_max tolerance was given");
+    assert!((99.0..=100.0).contains(&within), "{within}");
+}
+
+#[test]
+fn a_control_mesh_for_points_needs_no_reconstruction_only_when_given() {
+    let data = PolyMesh::from_points(ellipsoid(500)).expect("finite points");
+    // Without the reconstruction, simplification alone cannot start from bare points.
+    assert!(matches!(
+        geofit::fit::initial_control(&data, Some(50)),
+        Err(FitError::ControlMesh { .. })
+    ));
+    let two = PolyMesh::from_points(ellipsoid(2)).expect("finite points");
+    let err = build_subdiv_fitter(
+        &two,
+        None,
+        &ReconstructOptions::default(),
+        Scheme::Loop,
+        None,
+        None,
+        SubdivFitOptions::default(),
+    )
+    .err()
+    .expect("two points span no surface");
+    assert!(matches!(err, FitError::Reconstruct(_)), "{err}");
+}
+
+// ---- through `geofit fit` ----
+
+fn geofit(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_geofit"))
+        .args(args)
+        .output()
+        .expect("the geofit binary runs")
+}
+
+/// A fresh temporary directory for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("geofit-fit-cloud-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn write_xyz(path: &Path, points: &[Point3]) {
+    std::fs::write(path, xyz_text(points)).expect("write XYZ");
+}
+
+#[test]
+fn geofit_fit_reconstructs_a_closed_xyz_cloud_and_reports_it() {
+    let dir = temp_dir("closed");
+    let (file, json) = (dir.join("ellipsoid.xyz"), dir.join("r.json"));
+    write_xyz(&file, &ellipsoid(1_500));
+    let out = geofit(&[
+        "fit",
+        file.to_str().expect("utf-8"),
+        "--cloud",
+        "closed",
+        "--initial",
+        "60",
+        "--tol-avg",
+        "0.05",
+        "--tol-max",
+        "0.3",
+        "--max-iter",
+        "40",
+        "--json",
+        json.to_str().expect("utf-8"),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("reconstructed closed surface"), "{stdout}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).expect("report")).expect("JSON");
+    assert_eq!(report["points"], 1_500);
+    assert_eq!(report["converged"], true, "{report}");
+    assert!(report["e_max_pct"].as_f64().expect("number") <= 0.3);
+    assert_eq!(report["within_tolerance_pct"], 100.0);
+    let rec = &report["reconstruction"];
+    assert_eq!(rec["kind"], "closed");
+    let seconds = rec["seconds"].as_f64().expect("seconds");
+    assert!(seconds > 0.0 && seconds <= report["precompute_s"].as_f64().expect("number"));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn geofit_fit_on_degenerate_clouds_fails_clearly_or_fits_a_sheet() {
+    let dir = temp_dir("degenerate");
+    let line: Vec<Point3> = (0..20).map(|i| Point3::splat(i as f64)).collect();
+    let same = vec![Point3::new(1.0, 2.0, 3.0); 20];
+    let cases: [(&str, String, &str); 4] = [
+        ("three.xyz", "0 0 0\n1 0 0\n0 1 0\n".into(), "too few"),
+        ("line.xyz", xyz_text(&line), "collinear"),
+        ("same.xyz", xyz_text(&same), "all at one place"),
+        ("nan.xyz", "0 0 0\n1 0 0\n0 1 0\nNaN 1 1\n".into(), "line 4"),
+    ];
+    for (name, text, expected) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, text).expect("write");
+        let out = geofit(&["fit", path.to_str().expect("utf-8")]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name} succeeded");
+        assert!(
+            err.starts_with("geofit: ") && err.contains(expected),
+            "{name}: {err}"
+        );
+        assert!(!err.contains("panicked"), "{name}: {err}");
+    }
+    // Coplanar points are an open sheet: a sensible (flat) fit, not an error.
+    let flat: Vec<Point3> = (0..400)
+        .map(|k| Point3::new((k % 20) as f64, (k / 20) as f64, 0.0))
+        .collect();
+    let path = dir.join("flat.xyz");
+    write_xyz(&path, &flat);
+    let out = geofit(&["fit", path.to_str().expect("utf-8"), "--quiet"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("converged"), "{stdout}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+fn xyz_text(points: &[Point3]) -> String {
+    points
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect()
+}
