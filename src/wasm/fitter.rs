@@ -404,7 +404,8 @@ impl MeshArrays {
 ///
 /// `new Fitter(scan, {scheme, method, closed, tolAvg, tolMax, tolRms, initial, maxIter, refine,
 /// maxControl, weights, acceleration, cloud, outliers})` builds the initial control net (bare
-/// points are first reconstructed into a mesh for the subdivision schemes) and the first foot points;
+/// points are first reconstructed into a mesh for the subdivision schemes) and the first foot
+/// points;
 /// then `step()` or `run(budgetMs)` iterate. Tolerances are % of the bounding-box diagonal.
 #[wasm_bindgen]
 pub struct Fitter {

@@ -221,7 +221,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
                 fitter.initial_control_points(),
                 pre,
                 fit_s,
-                args.tol_max,
+                tol_max,
             );
             (
                 report_of(base, "least-squares", fitter.surface(), fitter.num_folded()),
@@ -250,7 +250,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
                 fitter.initial_control_points(),
                 pre,
                 fit_s,
-                args.tol_max,
+                tol_max,
             );
             (
                 report_of(base, "geometric", fitter.surface(), fitter.num_folded()),
