@@ -72,11 +72,31 @@ fn main() -> ExitCode {
 mod tests {
     use super::*;
 
-    /// clap checks its argument definitions (duplicate flags from flattened structs, bad
-    /// `requires`) only when asked: ask once here.
+    /// clap's own definition checks (`debug_assert`) run only with debug assertions, and the
+    /// tests run in release; so check here what flattening the scheme options can break: no
+    /// subcommand has two arguments with the same id, long flag or short flag.
     #[test]
-    fn command_line_definition_is_consistent() {
+    fn no_subcommand_repeats_a_flag() {
         use clap::CommandFactory;
-        Cli::command().debug_assert();
+        use std::collections::HashSet;
+        let cli = Cli::command();
+        cli.clone().debug_assert();
+        for sub in cli.get_subcommands() {
+            let (mut ids, mut longs, mut shorts) = (HashSet::new(), HashSet::new(), HashSet::new());
+            for arg in sub.get_arguments() {
+                let name = sub.get_name();
+                assert!(
+                    ids.insert(arg.get_id().clone()),
+                    "{name}: id {} twice",
+                    arg.get_id()
+                );
+                if let Some(long) = arg.get_long() {
+                    assert!(longs.insert(long), "{name}: --{long} twice");
+                }
+                if let Some(short) = arg.get_short() {
+                    assert!(shorts.insert(short), "{name}: -{short} twice");
+                }
+            }
+        }
     }
 }
