@@ -384,7 +384,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
   });
 
   test('the Fitter API throws Errors that name the problem', async () => {
-    const messages = await page.evaluate(async () => {
+    const { out: messages, cloudStats } = await page.evaluate(async () => {
       const m = await import(new URL('../pkg/geofit.js', location.href).href);
       const load = async (file) => m.loadFile(new Uint8Array(await (await fetch(`samples/${file}`)).arrayBuffer()), file);
       const caught = (f) => {
@@ -405,20 +405,26 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
         caught(() => new m.Fitter(mesh, { scheme: 'bspline-surface', method: 'newton' })),
         caught(() => new m.Fitter(mesh, { tolerance: 1 })),
         caught(() => new m.Fitter(mesh, { tolMax: -1 })),
-        caught(() => new m.Fitter(cloud, { scheme: 'loop' })),
+        caught(() => new m.Fitter(cloud, { scheme: 'loop', cloud: 'sideways' })),
         caught(() => curve.exportObj()),
         caught(() => loop.exportIges()),
         caught(() => new m.Fitter(mesh, { scheme: 'bspline-surface', initial: 4, maxIter: 1 }).step()),
         caught(() => new m.Fitter(mesh, { initial: 100 })),
       ];
+      // Bare points are meshed first (here by Delaunay, an open scan), then fitted like a mesh.
+      const cloudFitter = new m.Fitter(cloud, { scheme: 'loop', maxIter: 2 });
+      const cloudStats = cloudFitter.step();
+      cloudFitter.free();
       for (const x of [curve, loop, mesh, cloud, section]) x.free();
-      return out;
+      return { out, cloudStats };
     });
     assert.match(messages[0], /option scheme: 'nurbs' is not one of/);
     assert.match(messages[1], /option method: 'newton' is not one of/);
     assert.match(messages[2], /fit options: unknown field `tolerance`/);
     assert.match(messages[3], /tol/);
-    assert.match(messages[4], /no faces/);
+    assert.match(messages[4], /option cloud: 'sideways' is not one of/);
+    assert.equal(cloudStats.iter, 1);
+    assert.ok(cloudStats.controlPoints > 50 && Number.isFinite(cloudStats.eMaxPct), JSON.stringify(cloudStats));
     assert.match(messages[5], /a curve has no surface to export as a mesh/);
     assert.match(messages[6], /IGES and STEP export a B-spline/);
     assert.doesNotMatch(messages[7], /not an Error/);
