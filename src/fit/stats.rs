@@ -24,6 +24,24 @@ impl Default for Tolerances {
 }
 
 impl Tolerances {
+    /// The tolerances a user gave, or the defaults when none is given: giving one tolerance
+    /// means only that one counts, so the defaults must not mix in.
+    pub fn given_or_default(
+        avg_pct: Option<f64>,
+        max_pct: Option<f64>,
+        rms_pct: Option<f64>,
+    ) -> Self {
+        if avg_pct.is_some() || max_pct.is_some() || rms_pct.is_some() {
+            Tolerances {
+                avg_pct,
+                max_pct,
+                rms_pct,
+            }
+        } else {
+            Tolerances::default()
+        }
+    }
+
     /// Whether `stats` meets every tolerance given.
     pub fn met_by(&self, stats: &ErrorStats) -> bool {
         let ok = |tol: Option<f64>, value: f64| tol.is_none_or(|t| value <= t);

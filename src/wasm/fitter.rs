@@ -142,16 +142,7 @@ impl JsFitOptions {
 
     /// The tolerances given, or the core's defaults when none is.
     fn tolerances(&self) -> Tolerances {
-        let given = self.tol_avg.is_some() || self.tol_max.is_some() || self.tol_rms.is_some();
-        if given {
-            Tolerances {
-                avg_pct: self.tol_avg,
-                max_pct: self.tol_max,
-                rms_pct: self.tol_rms,
-            }
-        } else {
-            Tolerances::default()
-        }
+        Tolerances::given_or_default(self.tol_avg, self.tol_max, self.tol_rms)
     }
 
     /// The subdivision options; ranges are checked by [`SubdivFitOptions::validate`].

@@ -145,16 +145,7 @@ pub struct Args {
 
 impl Args {
     fn options(&self) -> SubdivFitOptions {
-        let given = self.tol_avg.is_some() || self.tol_max.is_some() || self.tol_rms.is_some();
-        let tolerances = if given {
-            Tolerances {
-                avg_pct: self.tol_avg,
-                max_pct: self.tol_max,
-                rms_pct: self.tol_rms,
-            }
-        } else {
-            Tolerances::default()
-        };
+        let tolerances = Tolerances::given_or_default(self.tol_avg, self.tol_max, self.tol_rms);
         let mut options = SubdivFitOptions::default()
             .with_tolerances(tolerances)
             .with_max_iter(self.max_iter)
