@@ -9,34 +9,18 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { startServer } from '../../scripts/serve.mjs';
 import { join } from 'node:path';
-import { BACKENDS, ROOT, launch, saveArtifact } from './helpers.mjs';
+import { BACKENDS, ROOT, countPixels, launch, saveArtifact } from './helpers.mjs';
 
 const TIMEOUT_MS = 180_000;
 const TOL_MAX = 0.5;
 
 /** Counts canvas pixels of the saturated (outside tolerance) red and blue of the error map. */
-async function errorPixels(page, file) {
-  const png = await page.locator('#view').screenshot();
-  saveArtifact(file, png);
-  return page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = new OffscreenCanvas(img.width, img.height);
-    const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0);
-    const { data } = ctx.getImageData(0, 0, img.width, img.height);
-    let red = 0;
-    let blue = 0;
-    let pale = 0;
-    for (let i = 0; i < data.length; i += 4) {
-      const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
-      if (r > 180 && g < 70 && b < 70) red += 1;
-      if (b > 180 && r < 70 && g < 120) blue += 1;
-      if (r > 150 && g > 150 && b > 150) pale += 1;
-    }
-    return { red, blue, pale };
-  }, png.toString('base64'));
+function errorPixels(page, file) {
+  return countPixels(page, '#view', file, {
+    red: (r, g, b) => r > 180 && g < 70 && b < 70,
+    blue: (r, g, b) => b > 180 && r < 70 && g < 120,
+    pale: (r, g, b) => r > 150 && g > 150 && b > 150,
+  });
 }
 
 /** Pixels of the chart canvas close to `hex` (a line colour). */
@@ -59,29 +43,15 @@ const fitIter = (page) => page.evaluate(() => Number(document.body.dataset.fitIt
  * Counts canvas pixels of the view by class: curve orange, iso cyan, initial net violet, zebra
  * dark grey and white, lit clay.
  */
-async function viewPixels(page, file) {
-  const png = await page.locator('#view').screenshot();
-  saveArtifact(file, png);
-  return page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = new OffscreenCanvas(img.width, img.height);
-    const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0);
-    const { data } = ctx.getImageData(0, 0, img.width, img.height);
-    const n = { orange: 0, cyan: 0, violet: 0, black: 0, white: 0, clay: 0 };
-    for (let i = 0; i < data.length; i += 4) {
-      const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
-      if (r > 200 && g > 100 && g < 180 && b < 60) n.orange += 1;
-      if (b > 200 && g > 170 && r < 130) n.cyan += 1;
-      if (b > 220 && r > 150 && r < 225 && g > 100 && g < 175) n.violet += 1;
-      if (r < 90 && Math.abs(r - g) < 5 && Math.abs(r - b) < 5) n.black += 1;
-      if (r > 200 && g > 200 && b > 200 && Math.abs(r - b) < 12) n.white += 1;
-      if (r > 120 && r - b > 15 && r - b < 60 && Math.abs(r - g) < 25) n.clay += 1;
-    }
-    return n;
-  }, png.toString('base64'));
+function viewPixels(page, file) {
+  return countPixels(page, '#view', file, {
+    orange: (r, g, b) => r > 200 && g > 100 && g < 180 && b < 60,
+    cyan: (r, g, b) => b > 200 && g > 170 && r < 130,
+    violet: (r, g, b) => b > 220 && r > 150 && r < 225 && g > 100 && g < 175,
+    black: (r, g, b) => r < 90 && Math.abs(r - g) < 5 && Math.abs(r - b) < 5,
+    white: (r, g, b) => r > 200 && g > 200 && b > 200 && Math.abs(r - b) < 12,
+    clay: (r, g, b) => r > 120 && r - b > 15 && r - b < 60 && Math.abs(r - g) < 25,
+  });
 }
 
 /** Clicks an export button and returns the downloaded bytes and file name. */

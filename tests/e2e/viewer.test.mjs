@@ -3,45 +3,11 @@
 // test-artifacts/.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
-import { dirname, join } from 'node:path';
-import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { join } from 'node:path';
 import { startServer } from '../../scripts/serve.mjs';
+import { BACKENDS, ROOT, countPixels, dataDir, launch, saveArtifact } from './helpers.mjs';
 
-const ROOT = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
-const ARTIFACTS = join(ROOT, 'test-artifacts');
-const CHROMIUM = '/usr/bin/chromium';
-const COMMON_ARGS = [
-  '--no-sandbox',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-  '--disable-quic',
-  '--disable-default-apps',
-];
-// Flag sets and the backend each one must give the page.
-const BACKENDS = [
-  { name: 'WebGL2', args: ['--enable-unsafe-swiftshader', '--use-angle=swiftshader'] },
-  {
-    name: 'WebGPU',
-    args: [
-      '--enable-unsafe-webgpu',
-      '--enable-unsafe-swiftshader',
-      '--enable-features=Vulkan',
-      '--use-vulkan=swiftshader',
-      '--use-angle=swiftshader',
-    ],
-  },
-];
 const TIMEOUT_MS = 60_000;
-
-/** The shared scans: $GEOFIT_DATA, else <repo>/../shared/data, else /work/shared/data. */
-function dataDir() {
-  const candidates = [process.env.GEOFIT_DATA, join(ROOT, '..', 'shared', 'data'), '/work/shared/data'];
-  return candidates.find((d) => d && existsSync(d));
-}
 
 /** Waits until the page has drawn a frame after `previous` frames. */
 async function nextFrame(page, previous) {
@@ -54,34 +20,21 @@ async function nextFrame(page, previous) {
 
 const framesDrawn = (page) => page.evaluate(() => Number(document.body.dataset.frames ?? 0));
 
+/** Near the background colour (the top-left corner pixel). */
+const isBackground = (r, g, b, [br, bg, bb]) => Math.abs(r - br) + Math.abs(g - bg) + Math.abs(b - bb) < 24;
+
 /**
- * Screenshots the canvas (saved under test-artifacts/) and classifies its pixels in the page:
- * background, the blue and amber ends of the height colours, and the clay of the lit surface.
+ * Screenshots the canvas (saved under test-artifacts/) and counts its pixels by class:
+ * drawn (not background), the blue and amber ends of the height colours, and the clay of the lit
+ * surface.
  */
-async function canvasPixels(page, file) {
-  const png = await page.locator('#view').screenshot();
-  mkdirSync(ARTIFACTS, { recursive: true });
-  writeFileSync(join(ARTIFACTS, file), png);
-  return page.evaluate(async (b64) => {
-    const img = new Image();
-    img.src = `data:image/png;base64,${b64}`;
-    await img.decode();
-    const c = new OffscreenCanvas(img.width, img.height);
-    const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0);
-    const { data } = ctx.getImageData(0, 0, img.width, img.height);
-    const [br, bg, bb] = [data[0], data[1], data[2]]; // a corner is background
-    const counts = { total: img.width * img.height, drawn: 0, blue: 0, amber: 0, clay: 0 };
-    for (let i = 0; i < data.length; i += 4) {
-      const [r, g, b] = [data[i], data[i + 1], data[i + 2]];
-      if (Math.abs(r - br) + Math.abs(g - bg) + Math.abs(b - bb) < 24) continue;
-      counts.drawn += 1;
-      if (b > 120 && b > r + 60) counts.blue += 1;
-      if (r > 170 && g > 80 && g < r - 30 && b < g - 40) counts.amber += 1;
-      if (r > 60 && Math.abs(r - g) < 30 && r >= b && r - b < 60) counts.clay += 1;
-    }
-    return { ...counts, background: [br, bg, bb] };
-  }, png.toString('base64'));
+function canvasPixels(page, file) {
+  return countPixels(page, '#view', file, {
+    drawn: (r, g, b, corner) => !isBackground(r, g, b, corner),
+    blue: (r, g, b, corner) => !isBackground(r, g, b, corner) && b > 120 && b > r + 60,
+    amber: (r, g, b, corner) => !isBackground(r, g, b, corner) && r > 170 && g > 80 && g < r - 30 && b < g - 40,
+    clay: (r, g, b, corner) => !isBackground(r, g, b, corner) && r > 60 && Math.abs(r - g) < 30 && r >= b && r - b < 60,
+  });
 }
 
 for (const backend of BACKENDS) {
@@ -96,11 +49,7 @@ for (const backend of BACKENDS) {
       const started = await startServer(0);
       server = started.server;
       pageUrl = started.url;
-      browser = await chromium.launch({
-        executablePath: CHROMIUM,
-        headless: true,
-        args: [...COMMON_ARGS, ...backend.args],
-      });
+      browser = await launch(backend);
       page = await browser.newPage({ viewport: { width: 800, height: 600 } });
       page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
       page.on('console', (m) => {
@@ -262,22 +211,9 @@ for (const backend of BACKENDS) {
         window.geofit.requestRender();
       });
       await nextFrame(page, n);
-      const png = await page.locator('#view').screenshot();
-      writeFileSync(join(ARTIFACTS, `lines-${backend.name}.png`), png);
-      const red = await page.evaluate(async (b64) => {
-        const img = new Image();
-        img.src = `data:image/png;base64,${b64}`;
-        await img.decode();
-        const c = new OffscreenCanvas(img.width, img.height);
-        const ctx = c.getContext('2d');
-        ctx.drawImage(img, 0, 0);
-        const { data } = ctx.getImageData(0, 0, img.width, img.height);
-        let count = 0;
-        for (let i = 0; i < data.length; i += 4) {
-          if (data[i] > 200 && data[i + 1] < 60 && data[i + 2] < 60) count += 1;
-        }
-        return count;
-      }, png.toString('base64'));
+      const { red } = await countPixels(page, '#view', `lines-${backend.name}.png`, {
+        red: (r, g, b) => r > 200 && g < 60 && b < 60,
+      });
       assert.ok(red > 200, `only ${red} red line pixels`);
       await page.evaluate(() => {
         window.geofit.viewer.setLines(new Float32Array(), new Float32Array());
@@ -304,7 +240,7 @@ for (const backend of BACKENDS) {
         assert.ok(m.css[1] > 200, `the view is only ${m.css[1]} px tall`);
         assert.ok(m.scrollWidth <= 360, `the page scrolls sideways: ${m.scrollWidth}`);
         assert.equal(await small.textContent('#num-points'), '2,007');
-        await small.locator('#view').screenshot({ path: join(ARTIFACTS, `narrow-dpr2-${backend.name}.png`) });
+        saveArtifact(`narrow-dpr2-${backend.name}.png`, await small.locator('#view').screenshot());
       } finally {
         await small.close();
       }
