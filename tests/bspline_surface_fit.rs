@@ -33,6 +33,7 @@ fn geometric_iteration_lowers_the_error_on_fixed_knots() {
             .with_tolerance(1e-6, TolMode::Exact)
             .with_acceleration(accel)
             .with_max_iterations(60)
+            .with_warm_start(false)
             .with_param(top());
         let mut fit = GeometricSurfaceFitter::try_new(&pts, opts).unwrap();
         let start = fit.stats().e_rms_pct;
@@ -42,6 +43,29 @@ fn geometric_iteration_lowers_the_error_on_fixed_knots() {
         assert!(end < 0.05 * start, "{accel:?}: {start} -> {end}");
         assert!(h.iter().all(|r| r.control_points == 81));
     }
+}
+
+#[test]
+fn warm_start_begins_near_the_optimum() {
+    let pts = wave(40);
+    let opts = |warm| {
+        GeometricSurfaceOptions::default()
+            .with_control(9, 9)
+            .with_fixed_knots(true)
+            .with_tolerance(1e-6, TolMode::Exact)
+            .with_max_iterations(3)
+            .with_warm_start(warm)
+            .with_param(top())
+    };
+    let mut cold = GeometricSurfaceFitter::try_new(&pts, opts(false)).unwrap();
+    let mut warm = GeometricSurfaceFitter::try_new(&pts, opts(true)).unwrap();
+    // Before any iteration the warm start is already a least-squares fit.
+    assert!(warm.stats().e_rms_pct < 0.2 * cold.stats().e_rms_pct);
+    cold.run().unwrap();
+    warm.run().unwrap();
+    let (c, w) = (cold.stats(), warm.stats());
+    assert!(w.e_rms_pct < c.e_rms_pct, "warm {w:?} cold {c:?}");
+    assert!(w.e_max_pct < c.e_max_pct, "warm {w:?} cold {c:?}");
 }
 
 #[test]

@@ -8,9 +8,9 @@
 //! was).
 
 use super::accel::Accelerator;
-use super::lsq_surface::{check_common, plane_surface};
+use super::lsq_surface::{check_common, plane_surface, LsqSurfaceFitter, LsqSurfaceOptions};
 use super::options::Acceleration;
-use super::parameterize::{check_points, parameterize, ParamOptions};
+use super::parameterize::{check_points, parameterize, ParamOptions, Parameterization};
 use super::patches::{
     correct_parameters, patch_errors, split_worst, Criterion, PatchGrid, TolMode,
 };
@@ -49,6 +49,12 @@ pub struct GeometricSurfaceOptions {
     pub newton_iterations: usize,
     /// How the initial parameters are found.
     pub param: ParamOptions,
+    /// Start from one smoothed least-squares solve ([`LsqSurfaceFitter`] with its default
+    /// weights, then a parameter correction) instead of the flat control net over the
+    /// projection plane. The error-vector iteration converges linearly from wherever it
+    /// starts; from the flat net most of its iterations only lift the net onto the data, which
+    /// one sparse solve does at the cost of about one iteration. Default true.
+    pub warm_start: bool,
 }
 
 impl Default for GeometricSurfaceOptions {
@@ -66,6 +72,7 @@ impl Default for GeometricSurfaceOptions {
             max_iterations: 200,
             newton_iterations: 3,
             param: ParamOptions::default(),
+            warm_start: true,
         }
     }
 }
@@ -112,6 +119,11 @@ impl GeometricSurfaceOptions {
         self.param = param;
         self
     }
+    /// Starts from a least-squares solve (true) or from the flat control net (false).
+    pub fn with_warm_start(mut self, warm: bool) -> Self {
+        self.warm_start = warm;
+        self
+    }
 }
 
 /// Geometric (error-vector) B-spline surface fitter, driven through [`Fitter`].
@@ -147,11 +159,14 @@ impl GeometricSurfaceFitter {
             }
         }
         check_points(points, opts.degree + 1)?;
-        let param = parameterize(points, &opts.param)?;
-        let surface = plane_surface(&param, opts.degree, opts.control)?;
+        let mut param = parameterize(points, &opts.param)?;
+        let mut surface = plane_surface(&param, opts.degree, opts.control)?;
         let active: Vec<bool> = (0..points.len())
             .map(|i| param.is_active(i, opts.param.fold_policy))
             .collect();
+        if opts.warm_start {
+            (surface, param.uv) = least_squares_start(points, param.clone(), surface, &opts)?;
+        }
         let diagonal = Aabb::from_points(points).map_or(0.0, |b| b.diagonal());
         let mut fitter = GeometricSurfaceFitter {
             points: points.to_vec(),
@@ -272,6 +287,26 @@ impl GeometricSurfaceFitter {
         }
         Ok(())
     }
+}
+
+/// One smoothed least-squares solve on the knots of `surface` with the parameters `param`,
+/// followed by a parameter correction: the warm start (surface, corrected parameters).
+fn least_squares_start(
+    points: &[Point3],
+    param: Parameterization,
+    surface: BSplineSurface,
+    opts: &GeometricSurfaceOptions,
+) -> Result<(BSplineSurface, Vec<[f64; 2]>), FitError> {
+    let lsq = LsqSurfaceOptions::default()
+        .with_degree(opts.degree)
+        .with_control(opts.control.0, opts.control.1)
+        .with_fixed_knots(true)
+        .with_solves_per_knots(1)
+        .with_tolerance(opts.tol_pct, opts.tol_mode)
+        .with_param(opts.param);
+    let mut fitter = LsqSurfaceFitter::with_parameters(points, param, surface, lsq)?;
+    fitter.step()?;
+    Ok((fitter.surface().clone(), fitter.parameters().to_vec()))
 }
 
 fn plain_step(x: &[Point3], d: &[Vec3]) -> Vec<Point3> {

@@ -351,17 +351,14 @@ impl LsqSurfaceFitter {
         };
         system.clear();
         let mut rhs = Mat::<f64>::zeros(nu * nv, 3);
-        let mut count = 0usize;
-        for ((pt, t), _) in self
+        let samples = self
             .points
             .iter()
             .zip(&self.uv)
             .zip(&self.active)
             .filter(|x| *x.1)
-        {
-            system.add_point(&self.surface, t[0], t[1], *pt, &mut rhs);
-            count += 1;
-        }
+            .map(|x| x.0);
+        let count = system.add_points(&self.surface, samples, &mut rhs);
         let grid = PatchGrid::of(&self.surface);
         let weights = patch_weights(
             &self.surface,
@@ -686,32 +683,73 @@ impl NormalSystem {
         self.col_ptr[c] + (ii - i0) * width + (jj - j0)
     }
 
-    /// Adds one data point: its basis products to the matrix and its weighted coordinates to
-    /// the right-hand side.
-    fn add_point(&mut self, s: &BSplineSurface, u: f64, v: f64, q: Point3, rhs: &mut Mat<f64>) {
-        let (_, nv, p, qd) = self.shape;
-        let b = s.basis(u, v);
-        let mut idx = [0usize; (MAX_DEGREE + 1) * (MAX_DEGREE + 1)];
-        let mut w = [0.0; (MAX_DEGREE + 1) * (MAX_DEGREE + 1)];
-        let mut m = 0;
-        for r in 0..=p {
-            for t in 0..=qd {
-                idx[m] = (b.first_u + r) * nv + b.first_v + t;
-                w[m] = b.bu[r] * b.bv[t];
-                m += 1;
+    /// Adds the data points (point, (u, v)): their basis products to the matrix and their
+    /// weighted coordinates to the right-hand side; returns how many there were.
+    ///
+    /// Points of one knot-span cell touch the same (p + 1)(q + 1) control points, so their
+    /// products are summed in a small dense block per cell first and scattered into the sparse
+    /// matrix once per cell: the per-point work is then plain multiply-adds on a contiguous
+    /// block, without locating each entry in the sparse pattern.
+    fn add_points<'a, I>(&mut self, s: &BSplineSurface, samples: I, rhs: &mut Mat<f64>) -> usize
+    where
+        I: Iterator<Item = (&'a Point3, &'a [f64; 2])>,
+    {
+        const MAX_M: usize = (MAX_DEGREE + 1) * (MAX_DEGREE + 1);
+        let (nu, nv, p, q) = self.shape;
+        let m = (p + 1) * (q + 1);
+        let tri = m * (m + 1) / 2;
+        let cells_v = nv - q;
+        let mut block_of = vec![usize::MAX; (nu - p) * cells_v];
+        let mut blocks: Vec<f64> = Vec::new();
+        let mut firsts: Vec<(usize, usize)> = Vec::new();
+        let mut count = 0;
+        for (pt, t) in samples {
+            count += 1;
+            let b = s.basis(t[0], t[1]);
+            let cell = b.first_u * cells_v + b.first_v;
+            if block_of[cell] == usize::MAX {
+                block_of[cell] = firsts.len();
+                firsts.push((b.first_u, b.first_v));
+                blocks.resize(blocks.len() + tri, 0.0);
+            }
+            let slot = block_of[cell];
+            let mut w = [0.0; MAX_M];
+            for r in 0..=p {
+                for c in 0..=q {
+                    w[r * (q + 1) + c] = b.bu[r] * b.bv[c];
+                }
+            }
+            let block = &mut blocks[slot * tri..(slot + 1) * tri];
+            let mut pos = 0;
+            for k in 0..m {
+                let wk = w[k];
+                for (dst, wl) in block[pos..=pos + k].iter_mut().zip(&w[..=k]) {
+                    *dst += wk * wl;
+                }
+                pos += k + 1;
+                let c = (b.first_u + k / (q + 1)) * nv + b.first_v + k % (q + 1);
+                rhs[(c, 0)] += wk * pt.x;
+                rhs[(c, 1)] += wk * pt.y;
+                rhs[(c, 2)] += wk * pt.z;
             }
         }
-        for k in 0..m {
-            let (c, wk) = (idx[k], w[k]);
-            for l in 0..=k {
-                // idx is increasing, so idx[l] ≤ idx[k].
-                let pos = self.position(idx[l], c);
-                self.values[pos] += wk * w[l];
+        let mut idx = [0usize; MAX_M];
+        for (slot, &(fu, fv)) in firsts.iter().enumerate() {
+            for (k, x) in idx.iter_mut().enumerate().take(m) {
+                *x = (fu + k / (q + 1)) * nv + fv + k % (q + 1);
             }
-            rhs[(c, 0)] += wk * q.x;
-            rhs[(c, 1)] += wk * q.y;
-            rhs[(c, 2)] += wk * q.z;
+            let block = &blocks[slot * tri..(slot + 1) * tri];
+            let mut pos = 0;
+            for k in 0..m {
+                for l in 0..=k {
+                    // idx is increasing, so idx[l] ≤ idx[k].
+                    let at = self.position(idx[l], idx[k]);
+                    self.values[at] += block[pos];
+                    pos += 1;
+                }
+            }
         }
+        count
     }
 
     /// Adds the per-patch weighted E2 and E3 Gram blocks (β2/ρ and β3·ρ per patch).

@@ -247,7 +247,9 @@ pub(crate) fn split_worst(
 
 /// Parameter correction: moves each point's (u, v) to its foot point on `surface` by Newton
 /// from the current value and stores the signed distance (positive on the side of S_u × S_v).
-/// Newton stops at a parameter step of 1e-9 of the domain: far below any fitting tolerance.
+/// Newton stops at a parameter step of 1e-7 of the domain: the distance, stationary at the foot
+/// point, is then off by a second-order amount far below any fitting tolerance, and the last,
+/// confirming evaluation of a tighter threshold (a quarter of the work) is saved.
 pub(crate) fn correct_parameters(
     surface: &BSplineSurface,
     points: &[Point3],
@@ -257,7 +259,7 @@ pub(crate) fn correct_parameters(
 ) {
     let opts = NewtonOptions::default()
         .with_max_iterations(iterations)
-        .with_param_tolerance(1e-9);
+        .with_param_tolerance(1e-7);
     for ((p, t), d) in points.iter().zip(uv.iter_mut()).zip(dist.iter_mut()) {
         let near = surface.closest_point(*p, t[0], t[1], opts);
         *t = [near.u, near.v];

@@ -114,32 +114,20 @@ impl KnotVector {
     /// `d` (A2.3): `out[k][j]` is the k-th derivative of N_{span-p+j}. Derivatives above the
     /// degree are zero. `u` is clamped into the domain.
     pub fn basis_ders(&self, span: usize, u: f64, d: usize, out: &mut [[f64; MAX_DEGREE + 1]]) {
-        let p = self.degree;
         let u = self.clamp(u);
         let k = &self.knots;
-        let mut ndu = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
-        let mut left = [0.0; MAX_DEGREE + 1];
-        let mut right = [0.0; MAX_DEGREE + 1];
-        ndu[0][0] = 1.0;
-        for j in 1..=p {
-            left[j] = u - k[span + 1 - j];
-            right[j] = k[span + j] - u;
-            let mut saved = 0.0;
-            for r in 0..j {
-                ndu[j][r] = right[r + 1] + left[j - r];
-                let temp = ndu[r][j - 1] / ndu[j][r];
-                ndu[r][j] = saved + right[r + 1] * temp;
-                saved = left[j - r] * temp;
-            }
-            ndu[j][j] = saved;
+        // One instance per degree: the scratch tables then have the degree's own size and the
+        // loops fixed bounds, which makes this (the inner loop of every foot-point search and
+        // of the normal-equation assembly) several times cheaper than tables of MAX_DEGREE.
+        match self.degree {
+            1 => basis_ders_n::<2>(k, span, u, d, out),
+            2 => basis_ders_n::<3>(k, span, u, d, out),
+            3 => basis_ders_n::<4>(k, span, u, d, out),
+            4 => basis_ders_n::<5>(k, span, u, d, out),
+            5 => basis_ders_n::<6>(k, span, u, d, out),
+            6 => basis_ders_n::<7>(k, span, u, d, out),
+            _ => basis_ders_n::<{ MAX_DEGREE + 1 }>(k, span, u, d, out),
         }
-        for row in out.iter_mut().take(d + 1) {
-            row.fill(0.0);
-        }
-        for j in 0..=p {
-            out[0][j] = ndu[j][p];
-        }
-        derivative_rows(p, d.min(p), &ndu, out);
     }
 
     /// The p + 1 non-zero basis values at `u` and the index of the first of them.
@@ -151,14 +139,55 @@ impl KnotVector {
     }
 }
 
-/// Rows 1..=d of A2.3: derivatives of the basis functions from the triangular table `ndu`.
-fn derivative_rows(
-    p: usize,
+/// A2.3 for degree p = N − 1: the N non-zero basis functions at `u` in `span` and their
+/// derivatives up to order `d` into `out[k][j]` (rows 0..=d; entries from N on are zeroed).
+fn basis_ders_n<const N: usize>(
+    k: &[f64],
+    span: usize,
+    u: f64,
     d: usize,
-    ndu: &[[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1],
     out: &mut [[f64; MAX_DEGREE + 1]],
 ) {
-    let mut a = [[0.0; MAX_DEGREE + 1]; 2];
+    let p = N - 1;
+    let mut ndu = [[0.0; N]; N];
+    // Reciprocals of the knot differences in ndu's lower triangle: the derivative rows divide
+    // by them again, so each difference is divided once.
+    let mut inv = [[0.0; N]; N];
+    let mut left = [0.0; N];
+    let mut right = [0.0; N];
+    ndu[0][0] = 1.0;
+    for j in 1..=p {
+        left[j] = u - k[span + 1 - j];
+        right[j] = k[span + j] - u;
+        let mut saved = 0.0;
+        for r in 0..j {
+            ndu[j][r] = right[r + 1] + left[j - r];
+            inv[j][r] = 1.0 / ndu[j][r];
+            let temp = ndu[r][j - 1] * inv[j][r];
+            ndu[r][j] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        ndu[j][j] = saved;
+    }
+    for row in out.iter_mut().take(d + 1) {
+        row.fill(0.0);
+    }
+    for j in 0..=p {
+        out[0][j] = ndu[j][p];
+    }
+    derivative_rows::<N>(d.min(p), &ndu, &inv, out);
+}
+
+/// Rows 1..=d of A2.3 for degree N − 1: derivatives of the basis functions from the triangular
+/// table `ndu` (`inv` holds the reciprocals of its lower triangle).
+fn derivative_rows<const N: usize>(
+    d: usize,
+    ndu: &[[f64; N]; N],
+    inv: &[[f64; N]; N],
+    out: &mut [[f64; MAX_DEGREE + 1]],
+) {
+    let p = N - 1;
+    let mut a = [[0.0; N]; 2];
     for r in 0..=p {
         let (mut s1, mut s2) = (0usize, 1usize);
         a[0][0] = 1.0;
@@ -167,7 +196,7 @@ fn derivative_rows(
             let rk = r as isize - k as isize;
             let pk = p - k;
             if r >= k {
-                a[s2][0] = a[s1][0] / ndu[pk + 1][rk as usize];
+                a[s2][0] = a[s1][0] * inv[pk + 1][rk as usize];
                 dval = a[s2][0] * ndu[rk as usize][pk];
             }
             let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
@@ -178,11 +207,11 @@ fn derivative_rows(
             };
             for j in j1..=j2 {
                 let idx = (rk + j as isize) as usize;
-                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                a[s2][j] = (a[s1][j] - a[s1][j - 1]) * inv[pk + 1][idx];
                 dval += a[s2][j] * ndu[idx][pk];
             }
             if r <= pk {
-                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                a[s2][k] = -a[s1][k - 1] * inv[pk + 1][r];
                 dval += a[s2][k] * ndu[r][pk];
             }
             out[k][r] = dval;

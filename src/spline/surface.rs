@@ -230,6 +230,9 @@ impl BSplineSurface {
         self.knots_u.basis_ders(su, u, d, &mut bu);
         self.knots_v.basis_ders(sv, v, d, &mut bv);
         let (fu, fv) = (su - p, sv - q);
+        let Some(weights) = &self.weights else {
+            return self.polynomial_derivs(&bu, &bv, (fu, fv), d);
+        };
         // Homogeneous sums: a[k][l] = Σ N^(k) M^(l) w P, w[k][l] = Σ N^(k) M^(l) w.
         let mut a = [[Vec3::ZERO; MAX_SURFACE_DERIV + 1]; MAX_SURFACE_DERIV + 1];
         let mut w = [[0.0; MAX_SURFACE_DERIV + 1]; MAX_SURFACE_DERIV + 1];
@@ -239,16 +242,8 @@ impl BSplineSurface {
             for (s, t) in temp.iter_mut().enumerate().take(q + 1) {
                 for r in 0..=p {
                     let idx = (fu + r) * nv + fv + s;
-                    match &self.weights {
-                        None => {
-                            t.0 += bu[k][r] * self.control[idx];
-                            t.1 += bu[k][r];
-                        }
-                        Some(w) => {
-                            t.0 += bu[k][r] * w[idx] * self.control[idx];
-                            t.1 += bu[k][r] * w[idx];
-                        }
-                    }
+                    t.0 += bu[k][r] * weights[idx] * self.control[idx];
+                    t.1 += bu[k][r] * weights[idx];
                 }
             }
             for l in 0..=(d - k) {
@@ -259,15 +254,39 @@ impl BSplineSurface {
             }
         }
         let mut out = SurfaceDerivs::default();
-        if self.weights.is_none() {
-            for k in 0..=d {
-                for l in 0..=(d - k) {
-                    out.skl[k][l] = a[k][l];
+        rational_derivs(&a, &w, d, &mut out);
+        out
+    }
+
+    /// The derivatives of a non-rational surface from the basis derivatives `bu`, `bv` of the
+    /// span whose first control point is (`fu`, `fv`): per control row, the v-sums first (one pass
+    /// over the row's q + 1 points), then the u-sums.
+    fn polynomial_derivs(
+        &self,
+        bu: &[[f64; MAX_DEGREE + 1]; MAX_SURFACE_DERIV + 1],
+        bv: &[[f64; MAX_DEGREE + 1]; MAX_SURFACE_DERIV + 1],
+        (fu, fv): (usize, usize),
+        d: usize,
+    ) -> SurfaceDerivs {
+        let (p, q) = (self.knots_u.degree(), self.knots_v.degree());
+        let nv = self.knots_v.num_basis();
+        let mut out = SurfaceDerivs::default();
+        for r in 0..=p {
+            let start = (fu + r) * nv + fv;
+            let row = &self.control[start..=start + q];
+            let mut c = [Vec3::ZERO; MAX_SURFACE_DERIV + 1];
+            for (l, cl) in c.iter_mut().enumerate().take(d + 1) {
+                for (s, pt) in row.iter().enumerate() {
+                    *cl += bv[l][s] * *pt;
                 }
             }
-            return out;
+            for (k, sk) in out.skl.iter_mut().enumerate().take(d + 1) {
+                let b = bu[k][r];
+                for (l, cl) in c.iter().enumerate().take(d + 1 - k) {
+                    sk[l] += b * *cl;
+                }
+            }
         }
-        rational_derivs(&a, &w, d, &mut out);
         out
     }
 
@@ -362,6 +381,14 @@ impl BSplineSurface {
             iterations += 1;
             let steps = newton_steps(&current, p);
             if steps.iter().all(Option::is_none) {
+                converged = true;
+                break;
+            }
+            // A step under the tolerance is the remaining parameter error (Newton converges
+            // quadratically): stop here without evaluating the surface once more.
+            let tiny_step =
+                |st: &(f64, f64)| st.0.abs().max(st.1.abs()) <= opts.param_tolerance * scale;
+            if steps.iter().flatten().next().is_some_and(tiny_step) {
                 converged = true;
                 break;
             }

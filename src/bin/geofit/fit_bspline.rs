@@ -15,6 +15,11 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// Least-squares solves on fixed knots by default: each parameter correction still lowers the
+/// error markedly up to about the fourth (on bun000.ply at 400 control points E_max 2.05, 1.79,
+/// 1.55, 1.44 %), and with fixed knots there is no splitting to continue from.
+const FIXED_KNOT_SOLVES: usize = 4;
+
 /// Fitting method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Method {
@@ -78,7 +83,7 @@ pub struct BsplineArgs {
     #[arg(long)]
     initial_ctrl: Option<usize>,
     /// Least squares: solves (each followed by parameter correction) per knot vector
-    /// [default: 2].
+    /// [default: 2; with --ctrl/--ctrl-u, where the knots never change, 4].
     #[arg(long)]
     solves: Option<usize>,
     /// View direction "x,y,z" for the projection [default: least-variance axis].
@@ -205,7 +210,11 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
                 .with_fixed_knots(fixed.is_some())
                 .with_tolerance(tol_max, mode)
                 .with_max_control_points(max_ctrl)
-                .with_solves_per_knots(args.solves.unwrap_or(d.solves_per_knots))
+                .with_solves_per_knots(args.solves.unwrap_or(if fixed.is_some() {
+                    FIXED_KNOT_SOLVES
+                } else {
+                    d.solves_per_knots
+                }))
                 .with_param(param)
                 .with_betas(args.beta2.unwrap_or(d.beta2), args.beta3.unwrap_or(d.beta3))
                 .with_max_iterations(common.max_iter);
