@@ -1,5 +1,6 @@
 //! `geofit info FILE [--json]`.
 
+use crate::output::{print_json, read_input};
 use std::path::PathBuf;
 
 /// Arguments of `geofit info`.
@@ -16,8 +17,7 @@ pub struct Args {
 /// after triangulating polygons and strips; a range scan's grid is reported as
 /// `range_grid: [cols, rows]` and not counted as triangles.
 pub fn run(args: Args) -> Result<(), String> {
-    let loaded =
-        geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
+    let loaded = read_input(&args.file)?;
     let mesh = &loaded.mesh;
     let bbox = mesh.bbox();
     let mut report = serde_json::json!({
@@ -36,11 +36,5 @@ pub fn run(args: Args) -> Result<(), String> {
     if loaded.dimension == 2 {
         report["dimension"] = 2.into();
     }
-    let text = if args.json {
-        report.to_string()
-    } else {
-        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-    };
-    println!("{text}");
-    Ok(())
+    print_json(&report, args.json)
 }

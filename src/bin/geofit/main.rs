@@ -8,6 +8,7 @@ mod fit;
 mod fit_bspline;
 mod fit_curve;
 mod info;
+mod output;
 mod reconstruct;
 mod simplify;
 mod subdiv;

@@ -1,6 +1,7 @@
 //! `geofit reconstruct FILE [-o OUT.obj] [--kind open|closed] [--no-grid] [--json]`: a mesh from
 //! bare points, timed, with the distance of the points to it.
 
+use crate::output::{print_json, read_input};
 use geofit::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
 use geofit::mesh::simplify::deviation;
 use std::path::PathBuf;
@@ -32,8 +33,7 @@ pub struct Args {
 /// Builds the mesh and prints its kind, counts, the time of the reconstruction alone
 /// (`reconstruct_s`) and the distance of every point to it (in % of the bounding-box diagonal).
 pub fn run(args: Args) -> Result<(), String> {
-    let loaded =
-        geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
+    let loaded = read_input(&args.file)?;
     let points = loaded.mesh.positions();
     let kind = match args.kind.as_deref() {
         Some("open") => Some(SurfaceKind::Open),
@@ -68,11 +68,5 @@ pub fn run(args: Args) -> Result<(), String> {
         "deviation_max_pct": dev.map(|d| d.max),
         "deviation_rms_pct": dev.map(|d| d.rms),
     });
-    let text = if args.json {
-        report.to_string()
-    } else {
-        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-    };
-    println!("{text}");
-    Ok(())
+    print_json(&report, args.json)
 }

@@ -1,6 +1,7 @@
 //! `geofit simplify FILE --target N [-o OUT.obj] [--json]`: QEM simplification, timed, with the
 //! distance of the input's points to the result.
 
+use crate::output::{print_json, read_input};
 use geofit::mesh::simplify::deviation;
 use geofit::mesh::{simplify_with, SimplifyOptions};
 use std::path::PathBuf;
@@ -35,8 +36,7 @@ pub struct Args {
 /// (`simplify_s`) and the distance of every input point to the result (`deviation_*_pct`, in %
 /// of the input's bounding-box diagonal).
 pub fn run(args: Args) -> Result<(), String> {
-    let loaded =
-        geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
+    let loaded = read_input(&args.file)?;
     let mesh = &loaded.mesh;
     let mut options = SimplifyOptions::default();
     if let Some(w) = args.boundary_weight {
@@ -66,13 +66,7 @@ pub fn run(args: Args) -> Result<(), String> {
         "deviation_rms_pct": dev.map(|d| d.rms),
         "deviation_mean_pct": dev.map(|d| d.mean),
     });
-    let text = if args.json {
-        report.to_string()
-    } else {
-        serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?
-    };
-    println!("{text}");
-    Ok(())
+    print_json(&report, args.json)
 }
 
 fn write(mesh: &geofit::mesh::PolyMesh, path: &std::path::Path) -> Result<(), String> {

@@ -1,5 +1,6 @@
 //! `geofit subdiv FILE --scheme loop|catmull-clark|doo-sabin --levels L -o OUT.obj [--limit]`.
 
+use crate::output::read_input;
 use geofit::mesh::ControlMesh;
 use geofit::subdiv::{limit_positions, refine_levels, Scheme};
 use std::path::PathBuf;
@@ -48,7 +49,7 @@ pub fn run(args: Args) -> Result<(), String> {
         ));
     }
     let name = args.file.display();
-    let loaded = geofit::io::read_path(&args.file).map_err(|e| format!("{name}: {e}"))?;
+    let loaded = read_input(&args.file)?;
     let control = ControlMesh::try_new(&loaded.mesh).map_err(|e| format!("{name}: {e}"))?;
     let refined =
         refine_levels(scheme, &control, args.levels).map_err(|e| format!("{name}: {e}"))?;

@@ -1,0 +1,23 @@
+//! What every subcommand does at its edges: read the input file with errors naming it, and print
+//! the JSON report (indented, or on one line with `--json`).
+
+use geofit::io::LoadedFile;
+use serde::Serialize;
+use std::path::Path;
+
+/// Reads `path` with the project's readers; the error names the file.
+pub fn read_input(path: &Path) -> Result<LoadedFile, String> {
+    geofit::io::read_path(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Prints `report` as JSON: on one line when `compact`, else indented.
+pub fn print_json(report: &impl Serialize, compact: bool) -> Result<(), String> {
+    let text = if compact {
+        serde_json::to_string(report)
+    } else {
+        serde_json::to_string_pretty(report)
+    }
+    .map_err(|e| e.to_string())?;
+    println!("{text}");
+    Ok(())
+}
