@@ -5,8 +5,8 @@
 
 use crate::export::{iges::write_iges, step::write_step, CurveDesc, ExportModel, SurfaceDesc};
 use crate::fit::{
-    CurveFitter, FitReport, FitStatus, Fitter, GeometricSurfaceFitter, LsqSurfaceFitter,
-    SubdivFitter,
+    within_tolerance_pct, CurveFitter, FitReport, FitStatus, Fitter, GeometricSurfaceFitter,
+    LsqSurfaceFitter, ReconstructionReport, SubdivFitter,
 };
 use crate::geom::{Aabb, Point3};
 use crate::mesh::PolyMesh;
@@ -45,6 +45,10 @@ pub(super) struct Fit {
     scheme: &'static str,
     data: Vec<Point3>,
     diagonal: f64,
+    /// The E_max tolerance in force (% of the diagonal), for `within_tolerance_pct`.
+    tol_max_pct: Option<f64>,
+    /// How bare points were made into a mesh, when they were.
+    reconstruction: Option<ReconstructionReport>,
 }
 
 impl Fit {
@@ -56,6 +60,24 @@ impl Fit {
             scheme,
             data,
             diagonal,
+            tol_max_pct: None,
+            reconstruction: None,
+        }
+    }
+
+    /// The fit with its E_max tolerance (% of the diagonal) known to the report.
+    pub(super) fn with_tolerance(self, tol_max_pct: Option<f64>) -> Fit {
+        Fit {
+            tol_max_pct,
+            ..self
+        }
+    }
+
+    /// The fit with the reconstruction that made its control mesh, for the report.
+    pub(super) fn with_reconstruction(self, reconstruction: Option<ReconstructionReport>) -> Fit {
+        Fit {
+            reconstruction,
+            ..self
         }
     }
 
@@ -222,7 +244,9 @@ impl Fit {
     /// The report of the fit now; `setup_s` is the whole set-up time, `fit_s` the iteration time.
     pub(super) fn report(&self, setup_s: f64, fit_s: f64) -> FitReport {
         if let Engine::Subdiv(f) = &self.engine {
-            return FitReport::of(f, setup_s - f.precompute_seconds(), fit_s);
+            let mut report = FitReport::of(f, setup_s - f.precompute_seconds(), fit_s);
+            report.reconstruction = self.reconstruction.clone();
+            return report;
         }
         let core = self.core();
         let stats = core.stats();
@@ -242,7 +266,9 @@ impl Fit {
             e_max_pct: stats.e_max_pct,
             e_rms_pct: stats.e_rms_pct,
             converged: self.status() == FitStatus::Converged,
-            within_tolerance_pct: None,
+            within_tolerance_pct: self
+                .tol_max_pct
+                .map(|tol| within_tolerance_pct(core.point_errors(), self.diagonal, tol)),
             reconstruction: None,
             precompute_s: setup_s,
             fit_s,

@@ -168,8 +168,9 @@ impl JsFitOptions {
             .max(4)
     }
 
-    /// The B-spline surface engine: error-vector (geometric) or least-squares, on E_max.
-    fn surface_engine(&self, points: &[Point3]) -> Result<Engine, JsError> {
+    /// The B-spline surface engine: error-vector (geometric) or least-squares, on E_max; with
+    /// the E_max tolerance in force.
+    fn surface_engine(&self, points: &[Point3]) -> Result<(Engine, Option<f64>), JsError> {
         let side = self.grid_side();
         let fixed = !self.refine.unwrap_or(true);
         match self.method.as_deref().unwrap_or("geometric") {
@@ -184,9 +185,9 @@ impl JsFitOptions {
                 if self.acceleration.is_some() {
                     o = o.with_acceleration(self.acceleration(Weighting::Basis)?);
                 }
-                Ok(Engine::Geometric(Box::new(
-                    GeometricSurfaceFitter::try_new(points, o)?,
-                )))
+                let tol = Some(o.tol_pct);
+                let fitter = GeometricSurfaceFitter::try_new(points, o)?;
+                Ok((Engine::Geometric(Box::new(fitter)), tol))
             }
             "least-squares" => {
                 let d = LsqSurfaceOptions::default();
@@ -196,9 +197,9 @@ impl JsFitOptions {
                     .with_tolerance(self.tol_max.unwrap_or(d.tol_pct), d.tol_mode)
                     .with_max_iterations(self.max_iter.unwrap_or(d.max_iterations))
                     .with_max_control_points(self.max_control.unwrap_or(d.max_control_points));
-                Ok(Engine::LeastSquares(Box::new(LsqSurfaceFitter::try_new(
-                    points, o,
-                )?)))
+                let tol = Some(o.tol_pct);
+                let fitter = LsqSurfaceFitter::try_new(points, o)?;
+                Ok((Engine::LeastSquares(Box::new(fitter)), tol))
             }
             other => Err(JsError::new(&format!(
                 "option method: '{other}' is not one of 'geometric', 'least-squares'"
@@ -207,8 +208,12 @@ impl JsFitOptions {
     }
 
     /// The curve engine: degree 3, or degree 2 for Chaikin (the limit of corner cutting is the
-    /// quadratic B-spline).
-    fn curve_engine(&self, scan: &LoadedScan, degree: usize) -> Result<Engine, JsError> {
+    /// quadratic B-spline); with the E_max tolerance in force.
+    fn curve_engine(
+        &self,
+        scan: &LoadedScan,
+        degree: usize,
+    ) -> Result<(Engine, Option<f64>), JsError> {
         let (points, file_closed) = scan.curve_points();
         let d = CurveFitOptions::default();
         let mut o = d
@@ -220,7 +225,11 @@ impl JsFitOptions {
         if self.acceleration.is_some() {
             o = o.with_acceleration(self.acceleration(Weighting::Basis)?);
         }
-        Ok(Engine::Curve(Box::new(CurveFitter::try_new(&points, o)?)))
+        let tol = o.tolerances.max_pct;
+        Ok((
+            Engine::Curve(Box::new(CurveFitter::try_new(&points, o)?)),
+            tol,
+        ))
     }
 
     /// How bare points become a mesh for the subdivision schemes; ranges are checked by the
@@ -244,7 +253,8 @@ impl JsFitOptions {
     /// The engine of the chosen scheme, fitting `scan`.
     fn build(&self, scan: &LoadedScan) -> Result<Fit, JsError> {
         let scheme = self.scheme()?;
-        let engine = match scheme {
+        let mut reconstruction = None;
+        let (engine, tol_max_pct) = match scheme {
             JsScheme::Subdiv(s) => {
                 let setup = build_subdiv_fitter(
                     scan.mesh(),
@@ -255,7 +265,9 @@ impl JsFitOptions {
                     self.initial,
                     self.to_core()?,
                 )?;
-                Engine::Subdiv(Box::new(setup.fitter))
+                reconstruction = setup.reconstruction;
+                let tol = setup.fitter.options().tolerances.max_pct;
+                (Engine::Subdiv(Box::new(setup.fitter)), tol)
             }
             JsScheme::BsplineSurface => self.surface_engine(scan.mesh().positions())?,
             JsScheme::BsplineCurve => self.curve_engine(scan, 3)?,
@@ -266,7 +278,9 @@ impl JsFitOptions {
             Engine::Curve(f) => f.data().to_vec(),
             Engine::Geometric(_) | Engine::LeastSquares(_) => scan.mesh().positions().to_vec(),
         };
-        Ok(Fit::new(engine, scheme.name(), data))
+        Ok(Fit::new(engine, scheme.name(), data)
+            .with_tolerance(tol_max_pct)
+            .with_reconstruction(reconstruction))
     }
 }
 

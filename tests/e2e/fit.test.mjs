@@ -354,7 +354,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
   });
 
   test('the Fitter API throws Errors that name the problem', async () => {
-    const { out: messages, cloudStats } = await page.evaluate(async () => {
+    const { out: messages, cloudStats, cloudReport, curveReport } = await page.evaluate(async () => {
       const m = await import(new URL('../pkg/geofit.js', location.href).href);
       const load = async (file) => m.loadFile(new Uint8Array(await (await fetch(`samples/${file}`)).arrayBuffer()), file);
       const caught = (f) => {
@@ -384,9 +384,12 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       // Bare points are meshed first (here by Delaunay, an open scan), then fitted like a mesh.
       const cloudFitter = new m.Fitter(cloud, { scheme: 'loop', maxIter: 2 });
       const cloudStats = cloudFitter.step();
+      const cloudReport = JSON.parse(cloudFitter.reportJson());
       cloudFitter.free();
+      curve.step();
+      const curveReport = JSON.parse(curve.reportJson());
       for (const x of [curve, loop, mesh, cloud, section]) x.free();
-      return { out, cloudStats };
+      return { out, cloudStats, cloudReport, curveReport };
     });
     assert.match(messages[0], /option scheme: 'nurbs' is not one of/);
     assert.match(messages[1], /option method: 'newton' is not one of/);
@@ -395,6 +398,11 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     assert.match(messages[4], /option cloud: 'sideways' is not one of/);
     assert.equal(cloudStats.iter, 1);
     assert.ok(cloudStats.controlPoints > 50 && Number.isFinite(cloudStats.eMaxPct), JSON.stringify(cloudStats));
+    // The report says how the points were meshed, and how many are within the E_max tolerance.
+    assert.equal(cloudReport.reconstruction?.kind, 'open', JSON.stringify(cloudReport.reconstruction));
+    assert.equal(cloudReport.reconstruction.triangles > 1000, true);
+    assert.ok(cloudReport.within_tolerance_pct > 0 && cloudReport.within_tolerance_pct <= 100);
+    assert.ok(curveReport.within_tolerance_pct >= 0 && curveReport.within_tolerance_pct <= 100, JSON.stringify(curveReport));
     assert.match(messages[5], /a curve has no surface to export as a mesh/);
     assert.match(messages[6], /IGES and STEP export a B-spline/);
     assert.doesNotMatch(messages[7], /not an Error/);
