@@ -25,21 +25,9 @@ impl LoadedScan {
         &self.file.mesh
     }
 
-    /// Ordered points for curve fitting and whether the file closes them into a loop: the
-    /// longest OBJ polyline (a last point repeating the first means closed), else every point
-    /// in file order (as `geofit fit-curve` reads them).
+    /// Ordered points for curve fitting and whether the file closes them into a loop.
     pub(crate) fn curve_points(&self) -> (Vec<Point3>, bool) {
-        let pos = self.file.mesh.positions();
-        let Some(line) = self.file.polylines.iter().max_by_key(|l| l.len()) else {
-            return (pos.to_vec(), false);
-        };
-        let closed = line.len() > 2 && line.first() == line.last();
-        let take = if closed { line.len() - 1 } else { line.len() };
-        let points = line[..take]
-            .iter()
-            .filter_map(|&i| pos.get(i as usize).copied())
-            .collect();
-        (points, closed)
+        self.file.curve_points()
     }
 
     /// The scanner grid of a raw range scan, if the file has one.

@@ -2,12 +2,12 @@
 //! [--json R.json] [--iges OUT.igs] [--step OUT.stp]`: fit a B-spline curve to an ordered point
 //! file (point text, two or three columns, or an OBJ polyline) and export it.
 
+use crate::output::read_input;
 use geofit::export::{iges::write_iges, step::write_step, CurveDesc, ExportModel};
 use geofit::fit::{
     CurveFitOptions, CurveFitter, FitStatus, Fitter, KnotPlacementFitter, KnotPlacementOptions,
     Tolerances,
 };
-use geofit::geom::Point3;
 use geofit::spline::BSplineCurve;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -62,21 +62,6 @@ pub struct Args {
     step: Option<PathBuf>,
 }
 
-/// The ordered points of `path` and whether the file marks them as a closed loop.
-fn read_curve_points(path: &Path) -> Result<(Vec<Point3>, bool), String> {
-    let loaded = geofit::io::read_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let pos = loaded.mesh.positions();
-    let Some(line) = loaded.polylines.iter().max_by_key(|l| l.len()) else {
-        return Ok((pos.to_vec(), false));
-    };
-    let closed = line.len() > 2 && line.first() == line.last();
-    let mut pts: Vec<Point3> = line.iter().map(|&i| pos[i as usize]).collect();
-    if closed {
-        pts.pop();
-    }
-    Ok((pts, closed))
-}
-
 /// Sample parameters and points of a curve, for the report and for interoperability checks.
 pub fn curve_samples(curve: &BSplineCurve, count: usize) -> Vec<[f64; 4]> {
     let (a, b) = curve.domain();
@@ -90,7 +75,7 @@ pub fn curve_samples(curve: &BSplineCurve, count: usize) -> Vec<[f64; 4]> {
 }
 
 pub fn run(args: Args) -> Result<(), String> {
-    let (points, file_closed) = read_curve_points(&args.file)?;
+    let (points, file_closed) = read_input(&args.file)?.curve_points();
     let closed = args.closed || file_closed;
     let tolerances = Tolerances {
         avg_pct: args.tol_avg,
