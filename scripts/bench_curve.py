@@ -10,11 +10,17 @@ SciPy's smoothing factor and OCC's tolerance is not timed, as a user would know 
 Usage: python scripts/bench_curve.py [SECTION.xyz] [--tol PCT]
 """
 import json
+import os
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+# One BLAS thread: geofit runs on one core, and on a loaded machine OpenBLAS's spinning threads
+# made SciPy's Delaunay transforms 50× slower (25 s instead of 0.5 s).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np
 from scipy.interpolate import BSpline, splev, splprep

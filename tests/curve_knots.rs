@@ -97,6 +97,24 @@ fn bunny_section_knot_placement_reaches_one_hundredth_percent() {
     assert!(fit.stats().e_max_pct <= 0.01);
 }
 
+#[test]
+fn batched_insertion_needs_fewer_solves_than_one_knot_per_solve() {
+    let pts = section("fandisk_section_x.xyz");
+    let run = |batch: bool| {
+        let opts = KnotPlacementOptions::default()
+            .with_closed(true)
+            .with_tolerances(max_only(0.01))
+            .with_batch(batch);
+        let mut fit = KnotPlacementFitter::try_new(&pts, opts).unwrap();
+        assert_eq!(fit.run().unwrap(), FitStatus::Converged, "batch {batch}");
+        assert!(fit.stats().e_max_pct <= 0.01);
+        (fit.history().len(), fit.curve().control_points().len())
+    };
+    let (single, batched) = (run(false), run(true));
+    eprintln!("one by one: {single:?} (solves, control points), batched: {batched:?}");
+    assert!(batched.0 < single.0, "{batched:?} vs {single:?}");
+}
+
 /// Angle between the one-sided tangents of `curve` at `u`, degrees.
 fn tangent_jump(curve: &BSplineCurve, u: f64) -> f64 {
     let (a, b) = curve.domain();

@@ -53,7 +53,11 @@ pub struct GeometricSurfaceOptions {
     /// weights, then a parameter correction) instead of the flat control net over the
     /// projection plane. The error-vector iteration converges linearly from wherever it
     /// starts; from the flat net most of its iterations only lift the net onto the data, which
-    /// one sparse solve does at the cost of about one iteration. Default true.
+    /// one sparse solve does at the cost of about one iteration — worth it on fixed knots
+    /// (bun000.ply, 400 control points: E_max 1.56 % after 3 iterations instead of 4.5 %).
+    /// With adaptive splitting it is not: the warm fit's gains fall under the stall threshold
+    /// sooner, so it splits earlier and ends with more control points (tol 0.1 %: 18,850
+    /// instead of 10,350). Default false.
     pub warm_start: bool,
 }
 
@@ -72,7 +76,7 @@ impl Default for GeometricSurfaceOptions {
             max_iterations: 200,
             newton_iterations: 3,
             param: ParamOptions::default(),
-            warm_start: true,
+            warm_start: false,
         }
     }
 }

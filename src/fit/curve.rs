@@ -215,22 +215,17 @@ impl CurveData {
             .map(|(&p, u)| {
                 let near = curve.closest_point_from(p, *u, newton_iter);
                 *u = near.u;
-                self.signed_distance(curve, p, &near)
+                self.signed_distance(p, &near)
             })
             .collect()
     }
 
-    fn signed_distance(
-        &self,
-        curve: &BSplineCurve,
-        p: Point3,
-        near: &crate::spline::CurveNearest,
-    ) -> f64 {
+    fn signed_distance(&self, p: Point3, near: &crate::spline::CurveNearest) -> f64 {
         let d = near.dist_sq.sqrt();
         if !self.planar {
             return d;
         }
-        let tangent = curve.eval_derivs(near.u, 1)[1];
+        let tangent = near.tangent;
         let normal = Vec3::new(-tangent.y, tangent.x, 0.0);
         if (p - near.point).dot(normal) < 0.0 {
             -d

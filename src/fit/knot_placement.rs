@@ -49,6 +49,13 @@ pub struct KnotPlacementOptions {
     pub parameter_correction: bool,
     /// Newton iterations per foot point [12].
     pub newton_iter: usize,
+    /// Insert, per solve, one knot in every knot span whose largest deviation exceeds the
+    /// E_max tolerance (each at that span's largest admissible deviation, worst span first)
+    /// instead of only at the single largest deviation [true]. The seed's one knot per solve
+    /// costs a solve and a measurement per knot; spans far apart barely interact, so their
+    /// knots can share a solve (bunny section at E_max 0.01 %: 428 control points in 409
+    /// solves one by one).
+    pub batch: bool,
 }
 
 impl Default for KnotPlacementOptions {
@@ -63,6 +70,7 @@ impl Default for KnotPlacementOptions {
             max_iter: None,
             parameter_correction: false,
             newton_iter: 12,
+            batch: true,
         }
     }
 }
@@ -101,6 +109,11 @@ impl KnotPlacementOptions {
     /// Sets the cap on insertions.
     pub fn with_max_iter(mut self, max_iter: Option<usize>) -> Self {
         self.max_iter = max_iter;
+        self
+    }
+    /// Sets whether knots are inserted in every failing span per solve.
+    pub fn with_batch(mut self, batch: bool) -> Self {
+        self.batch = batch;
         self
     }
     /// Sets whether parameters are corrected between solves.
@@ -256,6 +269,8 @@ pub struct KnotPlacementFitter {
     knots: Vec<Knot>,
     curve: BSplineCurve,
     params: Vec<f64>,
+    /// Foot-point parameters on the current curve (the warm start of the next measurement).
+    feet: Vec<f64>,
     errors: Vec<f64>,
     stats: ErrorStats,
     history: Vec<IterationRecord>,
@@ -295,6 +310,7 @@ impl KnotPlacementFitter {
             knots,
             curve,
             params,
+            feet: Vec::new(),
             errors: Vec::new(),
             stats: ErrorStats::default(),
             history: Vec::new(),
@@ -350,20 +366,26 @@ impl KnotPlacementFitter {
             && self.options.std_pct.is_none_or(|s| self.std_pct() <= s)
     }
 
-    /// Foot points (normal deviations) of the data on the current curve.
+    /// Foot points (normal deviations) of the data on the current curve, Newton started from
+    /// the previous foot points: one knot changes the curve only a little, so this takes a
+    /// step or two where the chord-length start took several.
     fn measure(&mut self) {
-        let mut params = self.params.clone();
+        if self.feet.len() != self.params.len() {
+            self.feet = self.params.clone();
+        }
         self.errors = self
             .data
-            .foot_points(&self.curve, &mut params, self.options.newton_iter);
+            .foot_points(&self.curve, &mut self.feet, self.options.newton_iter);
         if self.options.parameter_correction {
-            self.params = params;
+            self.params.clone_from(&self.feet);
         }
         self.stats = ErrorStats::from_distances(&self.errors, self.data.diagonal);
     }
 
-    /// The foot parameter of the largest admissible deviation, per the spacing rules.
-    fn next_knot(&self) -> Option<f64> {
+    /// Inserts the knots of one step: at the largest admissible deviation (per the spacing
+    /// rules) and, with [`KnotPlacementOptions::batch`], at the largest admissible deviation
+    /// above the E_max tolerance of every other knot span. Returns how many were inserted.
+    fn insert_knots(&mut self) -> usize {
         let mut order: Vec<usize> = (0..self.errors.len()).collect();
         order.sort_by(|&a, &b| self.errors[b].abs().total_cmp(&self.errors[a].abs()));
         let mut sorted: Vec<f64> = self
@@ -372,10 +394,32 @@ impl KnotPlacementFitter {
             .map(|&t| self.curve.normalize_param(t))
             .collect();
         sorted.sort_by(f64::total_cmp);
-        order
-            .into_iter()
-            .map(|i| self.curve.normalize_param(self.params[i]))
-            .find(|&u| self.admissible(u, &sorted))
+        let tol = (self.options.tolerances.max_pct)
+            .map_or(f64::INFINITY, |t| t / 100.0 * self.data.diagonal);
+        let spans: Vec<f64> = self.knots.iter().map(|k| k.value).collect();
+        let mut used: Vec<usize> = Vec::new();
+        for i in order {
+            if !used.is_empty() && (!self.options.batch || self.errors[i].abs() <= tol) {
+                break;
+            }
+            let u = self.curve.normalize_param(self.params[i]);
+            let span = spans.partition_point(|&k| k < u);
+            if used.contains(&span) || !self.admissible(u, &sorted) {
+                continue;
+            }
+            used.push(span);
+            // Knot values live in the curve's domain (a closed curve's period starts at its
+            // first knot), so sorted insertion keeps the seam first.
+            let pos = self.knots.partition_point(|k| k.value < u);
+            self.knots.insert(
+                pos,
+                Knot {
+                    value: u,
+                    multiplicity: 1,
+                },
+            );
+        }
+        used.len()
     }
 
     /// Whether a single knot at `u` keeps ≥ 1 data point to each neighbouring knot (2 to a
@@ -467,20 +511,10 @@ impl Fitter for KnotPlacementFitter {
         }
         let start = Instant::now();
         let cap = self.options.max_iter.unwrap_or(self.data.points.len());
-        let Some(u) = self.next_knot() else {
+        if self.insert_knots() == 0 {
             self.status = FitStatus::MaxIterations;
             return Ok(self.status);
-        };
-        // Knot values live in the curve's domain (a closed curve's period starts at its first
-        // knot), so sorted insertion keeps the seam first.
-        let pos = self.knots.partition_point(|k| k.value < u);
-        self.knots.insert(
-            pos,
-            Knot {
-                value: u,
-                multiplicity: 1,
-            },
-        );
+        }
         let template = template_curve(
             &self.knots,
             self.options.degree,

@@ -6,7 +6,7 @@
 
 use super::knots::{KnotVector, MAX_DEGREE};
 use super::SplineError;
-use crate::geom::Point3;
+use crate::geom::{Point3, Vec3};
 use glam::DVec4;
 
 /// Highest derivative order [`BSplineCurve::eval_derivs`] returns.
@@ -34,6 +34,8 @@ pub struct CurveNearest {
     pub point: Point3,
     /// Squared distance from the query point to the foot point.
     pub dist_sq: f64,
+    /// The first derivative C'(u) at the foot point (it orients signed distances).
+    pub tangent: Vec3,
     /// Newton iterations used.
     pub iterations: usize,
     /// Whether the Newton step fell below the parameter tolerance.
@@ -291,13 +293,13 @@ impl BSplineCurve {
             // Newton where the curve is locally convex towards p, Gauss–Newton elsewhere.
             let denom = if fp > 1e-3 * g { fp } else { g };
             if denom.is_nan() || denom <= 0.0 {
-                return self.nearest(u, c[0], dist_sq, it, true);
+                return self.nearest(u, &c, dist_sq, it, true);
             }
             let speed = g.sqrt();
             let tol = 1e-12 * (b - a) + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
             let mut du = (-f / denom).clamp(-0.25 * (b - a), 0.25 * (b - a));
             if du.abs() <= tol {
-                return self.nearest(u, c[0], dist_sq, it, true);
+                return self.nearest(u, &c, dist_sq, it, true);
             }
             let mut accepted = false;
             for _ in 0..8 {
@@ -314,10 +316,10 @@ impl BSplineCurve {
                 du *= 0.5;
             }
             if !accepted {
-                return self.nearest(u, c[0], dist_sq, it + 1, true);
+                return self.nearest(u, &c, dist_sq, it + 1, true);
             }
         }
-        self.nearest(u, c[0], dist_sq, max_iter, false)
+        self.nearest(u, &c, dist_sq, max_iter, false)
     }
 
     /// The foot point of `p`, seeded from the best of `samples_per_span` samples in every knot
@@ -356,15 +358,16 @@ impl BSplineCurve {
     fn nearest(
         &self,
         u: f64,
-        point: Point3,
+        c: &[Point3; MAX_DERIV + 1],
         dist_sq: f64,
         iterations: usize,
         converged: bool,
     ) -> CurveNearest {
         CurveNearest {
             u,
-            point,
+            point: c[0],
             dist_sq,
+            tangent: c[1],
             iterations,
             converged,
         }

@@ -70,7 +70,8 @@ pub struct BsplineArgs {
     /// How patches are judged against --tol-max [default: noisy].
     #[arg(long, value_enum)]
     tol_mode: Option<TolModeArg>,
-    /// Fixed control-point count N (a √N × √N grid, knots kept fixed).
+    /// Fixed control-point count N (a √N × √N grid, knots kept fixed; the geometric method
+    /// then starts from one least-squares solve).
     #[arg(long, conflicts_with_all = ["ctrl_u", "ctrl_v"])]
     ctrl: Option<usize>,
     /// Fixed control points along u (with --ctrl-v; knots kept fixed).
@@ -242,6 +243,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
                 .with_degree(degree)
                 .with_control(control.0, control.1)
                 .with_fixed_knots(fixed.is_some())
+                .with_warm_start(fixed.is_some())
                 .with_tolerance(tol_max, mode)
                 .with_max_control_points(max_ctrl)
                 .with_param(param)
