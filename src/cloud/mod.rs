@@ -38,7 +38,6 @@
 
 mod cleanup;
 mod closed;
-mod eigen;
 mod error;
 mod neighbours;
 mod normals;

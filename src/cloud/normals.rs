@@ -2,8 +2,8 @@
 //! neighbours, oriented consistently by propagation along a minimum spanning tree of the
 //! neighbour graph (Hoppe et al. 1992, "Surface reconstruction from unorganized points").
 
-use super::eigen::symmetric_eigen;
 use super::neighbours::Neighbours;
+use crate::geom::symmetric_eigen;
 use crate::geom::{Point3, Vec3};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;

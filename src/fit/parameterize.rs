@@ -9,7 +9,7 @@
 //! by [`FoldPolicy`], reported as an error, excluded from the fit, or kept.
 
 use super::FitError;
-use crate::geom::{Point3, Vec3};
+use crate::geom::{symmetric_eigen, Point3, Vec3};
 use crate::spline::{BSplineSurface, NewtonOptions};
 use std::collections::HashMap;
 
@@ -424,8 +424,7 @@ fn extent<I: Iterator<Item = f64>>(values: I) -> (f64, f64) {
     })
 }
 
-/// Eigenvalues (descending) and unit eigenvectors of the points' covariance matrix (cyclic
-/// Jacobi on the symmetric 3 × 3 matrix).
+/// Eigenvalues (descending) and unit eigenvectors of the points' covariance matrix.
 fn principal_axes(points: &[Point3], center: Point3) -> ([f64; 3], [Vec3; 3]) {
     let mut c = [[0.0; 3]; 3];
     for p in points {
@@ -442,69 +441,16 @@ fn principal_axes(points: &[Point3], center: Point3) -> ([f64; 3], [Vec3; 3]) {
             *x /= n;
         }
     }
-    let (values, vectors) = jacobi_eigen(c);
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&a, &b| values[b].total_cmp(&values[a]));
-    let axis = |k: usize| Vec3::new(vectors[0][k], vectors[1][k], vectors[2][k]);
+    let (values, vectors) = symmetric_eigen(c);
     (
-        [values[order[0]], values[order[1]], values[order[2]]],
-        [axis(order[0]), axis(order[1]), axis(order[2])],
+        [values[2], values[1], values[0]],
+        [vectors[2], vectors[1], vectors[0]],
     )
-}
-
-/// Cyclic Jacobi eigen-decomposition of a symmetric 3 × 3 matrix: (eigenvalues, eigenvectors as
-/// the columns of the second result).
-fn jacobi_eigen(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
-    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-    for _sweep in 0..50 {
-        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
-        let diag = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
-        if off <= 1e-15 * diag || off == 0.0 {
-            break;
-        }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q] == 0.0 {
-                continue;
-            }
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-            let t = if theta == 0.0 { 1.0 } else { t };
-            let (cs, sn) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
-            for k in 0..3 {
-                let (akp, akq) = (a[k][p], a[k][q]);
-                a[k][p] = cs * akp - sn * akq;
-                a[k][q] = sn * akp + cs * akq;
-            }
-            for k in 0..3 {
-                let (apk, aqk) = (a[p][k], a[q][k]);
-                a[p][k] = cs * apk - sn * aqk;
-                a[q][k] = sn * apk + cs * aqk;
-            }
-            for row in v.iter_mut() {
-                let (vp, vq) = (row[p], row[q]);
-                row[p] = cs * vp - sn * vq;
-                row[q] = sn * vp + cs * vq;
-            }
-        }
-    }
-    ([a[0][0], a[1][1], a[2][2]], v)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn jacobi_diagonalises() {
-        let m = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 1.0]];
-        let (vals, vecs) = jacobi_eigen(m);
-        for k in 0..3 {
-            for r in 0..3 {
-                let mv: f64 = (0..3).map(|s| m[r][s] * vecs[s][k]).sum();
-                assert!((mv - vals[k] * vecs[r][k]).abs() < 1e-12);
-            }
-        }
-    }
 
     #[test]
     fn layers_split_at_gaps() {

@@ -1,8 +1,10 @@
 //! Geometric primitives in f64: points, vectors, axis-aligned boxes.
 
 mod aabb;
+mod eigen;
 
 pub use aabb::Aabb;
+pub use eigen::symmetric_eigen;
 
 /// A point in 3D space (f64). An alias of glam's `DVec3`, so points and vectors share maths.
 pub type Point3 = glam::DVec3;

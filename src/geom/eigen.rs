@@ -1,10 +1,10 @@
 //! Eigen-decomposition of symmetric 3×3 matrices (cyclic Jacobi), for principal directions of
-//! point neighbourhoods.
+//! point clouds and neighbourhoods.
 
 use crate::geom::Vec3;
 
 /// Eigenvalues (ascending) and unit eigenvectors of the symmetric matrix `m` (row-major).
-pub(super) fn symmetric_eigen(m: [[f64; 3]; 3]) -> ([f64; 3], [Vec3; 3]) {
+pub fn symmetric_eigen(m: [[f64; 3]; 3]) -> ([f64; 3], [Vec3; 3]) {
     let mut a = m;
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     for _ in 0..32 {
