@@ -4,10 +4,11 @@
 mod common;
 
 use common::meshes::{cube, jitter, quad_grid};
-use geofit::geom::{Point3, Vec3};
+use common::surface_checks::{assert_c1_across_edges, close, normal};
+use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
 use geofit::subdiv::{
-    quadrangulate, refine, CatmullClarkSurface, LimitEval, LimitSurface, Scheme, SurfaceParam,
+    quadrangulate, refine, CatmullClarkSurface, LimitSurface, Scheme, SurfaceParam,
 };
 
 fn surface(mesh: &PolyMesh) -> CatmullClarkSurface {
@@ -28,14 +29,6 @@ fn to_parent(c: usize, u: f64, v: f64) -> (f64, f64) {
         2 => (1.0 - u / 2.0, 1.0 - v / 2.0),
         _ => (v / 2.0, 1.0 - u / 2.0),
     }
-}
-
-fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
-    (a - b).length() <= tol * (1.0 + a.length().max(b.length()))
-}
-
-fn normal(e: &LimitEval) -> Vec3 {
-    e.du.cross(e.dv).normalize()
 }
 
 fn spot_quads() -> PolyMesh {
@@ -199,47 +192,7 @@ fn open_boundary_limit_curve_is_the_cubic_bspline_of_the_boundary() {
 #[test]
 fn limit_surface_is_c1_across_patch_edges() {
     for mesh in [jitter(&cube(), 0.1, 6), spot_quads()] {
-        let s = surface(&mesh);
-        let cm = s.control_mesh();
-        for f in 0..cm.num_faces() as u32 {
-            for (k, h) in cm.face_half_edges(f).enumerate() {
-                let t = cm.twin(h);
-                if t == geofit::mesh::NONE {
-                    continue;
-                }
-                let g = cm.face_of(t);
-                let kt = cm.face_half_edges(g).position(|x| x == t).unwrap();
-                for i in 1..8 {
-                    let a = i as f64 / 8.0;
-                    let (u, v) = edge_param(k, a);
-                    let (ug, vg) = edge_param(kt, 1.0 - a);
-                    let ea = s.eval(SurfaceParam { patch: f, u, v });
-                    let eb = s.eval(SurfaceParam {
-                        patch: g,
-                        u: ug,
-                        v: vg,
-                    });
-                    assert!(
-                        close(ea.point, eb.point, 1e-9),
-                        "edge of face {f}: position"
-                    );
-                    assert!(
-                        (normal(&ea) - normal(&eb)).length() < 1e-9,
-                        "edge of face {f}: normal"
-                    );
-                }
-            }
-        }
-    }
-}
-
-/// Parameters at fraction `a` along side `k` of the unit square (from corner k to corner k+1).
-fn edge_param(k: usize, a: f64) -> (f64, f64) {
-    match k {
-        0 => (a, 0.0),
-        1 => (1.0, a),
-        2 => (1.0 - a, 1.0),
-        _ => (0.0, 1.0 - a),
+        assert_c1_across_edges(&surface(&mesh), 8);
     }
 }
 

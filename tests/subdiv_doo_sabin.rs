@@ -6,14 +6,11 @@
 mod common;
 
 use common::meshes::{cube, icosahedron, jitter, quad_grid};
-use geofit::geom::{Point3, Vec3};
+use common::surface_checks::close;
+use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
 use geofit::subdiv::{refine, DooSabinSurface, LimitSurface, Scheme, SurfaceParam};
 use std::collections::HashMap;
-
-fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
-    (a - b).length() <= tol * (1.0 + a.length().max(b.length()))
-}
 
 #[test]
 fn refinement_uses_the_doo_sabin_weights_and_counts() {

@@ -4,11 +4,10 @@
 mod common;
 
 use common::meshes::{icosahedron, jitter, octahedron, tri_grid};
-use geofit::geom::{Point3, Vec3};
+use common::surface_checks::{assert_c1_across_edges, close};
+use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
-use geofit::subdiv::{
-    refine, refine_levels, LimitEval, LimitSurface, LoopSurface, Scheme, SurfaceParam,
-};
+use geofit::subdiv::{refine, refine_levels, LimitSurface, LoopSurface, Scheme, SurfaceParam};
 
 fn loop_surface(mesh: &PolyMesh) -> LoopSurface {
     LoopSurface::try_new(mesh).expect("valid control mesh")
@@ -46,10 +45,6 @@ fn samples() -> Vec<(f64, f64)> {
     }
     out.retain(|&(u, v)| u + v <= 1.0);
     out
-}
-
-fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
-    (a - b).length() <= tol * (1.0 + a.length().max(b.length()))
 }
 
 /// The surface of the once-refined mesh is the same surface: exact evaluation must agree
@@ -273,10 +268,6 @@ fn refined_vertices_approach_the_limit_at_the_expected_rate() {
     }
 }
 
-fn normal(e: &LimitEval) -> Vec3 {
-    e.du.cross(e.dv).normalize()
-}
-
 /// Positions and tangent planes agree across every shared edge (C1) to 1e-9.
 #[test]
 fn limit_surface_is_c1_across_patch_edges() {
@@ -284,46 +275,7 @@ fn limit_surface_is_c1_across_patch_edges() {
         jitter(&icosahedron(), 0.2, 7),
         jitter(&tri_grid(4, |x, y| (x + y).sin()), 0.1, 8),
     ] {
-        let s = loop_surface(&mesh);
-        let cm = s.control_mesh();
-        for f in 0..cm.num_faces() as u32 {
-            for (k, h) in cm.face_half_edges(f).enumerate() {
-                let t = cm.twin(h);
-                if t == geofit::mesh::NONE {
-                    continue;
-                }
-                let g = cm.face_of(t);
-                let kt = cm.face_half_edges(g).position(|x| x == t).unwrap();
-                for i in 1..10 {
-                    let a = i as f64 / 10.0;
-                    let (u, v) = edge_param(k, a);
-                    let (ug, vg) = edge_param(kt, 1.0 - a);
-                    let ea = s.eval(SurfaceParam { patch: f, u, v });
-                    let eb = s.eval(SurfaceParam {
-                        patch: g,
-                        u: ug,
-                        v: vg,
-                    });
-                    assert!(
-                        close(ea.point, eb.point, 1e-9),
-                        "edge of face {f}: position"
-                    );
-                    assert!(
-                        (normal(&ea) - normal(&eb)).length() < 1e-9,
-                        "edge of face {f}: normal"
-                    );
-                }
-            }
-        }
-    }
-}
-
-/// Parameters at fraction `a` along edge `k` of a triangle (from corner k to corner k+1).
-fn edge_param(k: usize, a: f64) -> (f64, f64) {
-    match k {
-        0 => (a, 0.0),
-        1 => (1.0 - a, a),
-        _ => (0.0, 1.0 - a),
+        assert_c1_across_edges(&loop_surface(&mesh), 10);
     }
 }
 

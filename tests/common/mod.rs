@@ -5,6 +5,7 @@
 pub mod linear;
 pub mod manifold;
 pub mod meshes;
+pub mod surface_checks;
 
 use geofit::geom::Point3;
 use geofit::mesh::PolyMesh;
