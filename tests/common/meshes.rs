@@ -68,9 +68,8 @@ pub fn octahedron() -> PolyMesh {
     PolyMesh::try_new(p, f).unwrap()
 }
 
-/// An n × n grid of unit squares in the plane z = h(x, y), each split into two triangles along
-/// the same diagonal (a regular triangulation: interior valence 6).
-pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
+/// The (n + 1)² points (i, j, h(i, j)) of an n × n grid of unit squares, row by row.
+fn grid_points(n: usize, h: impl Fn(f64, f64) -> f64) -> Vec<Point3> {
     let mut p = Vec::new();
     for j in 0..=n {
         for i in 0..=n {
@@ -78,6 +77,13 @@ pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
             p.push(Point3::new(x, y, h(x, y)));
         }
     }
+    p
+}
+
+/// An n × n grid of unit squares in the plane z = h(x, y), each split into two triangles along
+/// the same diagonal (a regular triangulation: interior valence 6).
+pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
+    let p = grid_points(n, h);
     let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
     let mut f = Vec::new();
     for j in 0..n {
@@ -91,13 +97,7 @@ pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
 
 /// An n × n quad grid in the plane z = h(x, y).
 pub fn quad_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
-    let mut p = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64, j as f64);
-            p.push(Point3::new(x, y, h(x, y)));
-        }
-    }
+    let p = grid_points(n, h);
     let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
     let mut f = Vec::new();
     for j in 0..n {

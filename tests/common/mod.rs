@@ -49,24 +49,9 @@ impl Rng {
 /// An octahedron subdivided `levels` times (midpoints pushed onto the unit sphere): a closed,
 /// consistently oriented triangle mesh with valence-4 and valence-6 vertices.
 pub fn sphere_mesh(levels: usize) -> PolyMesh {
-    let mut pts = vec![
-        Point3::X,
-        Point3::NEG_X,
-        Point3::Y,
-        Point3::NEG_Y,
-        Point3::Z,
-        Point3::NEG_Z,
-    ];
-    let mut tris: Vec<[u32; 3]> = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let octahedron = meshes::octahedron();
+    let mut pts = octahedron.positions().to_vec();
+    let mut tris: Vec<[u32; 3]> = octahedron.triangles();
     for _ in 0..levels {
         let mut mid = std::collections::HashMap::new();
         let mut next = Vec::new();
