@@ -4,10 +4,11 @@
 Every surface (geofit's, SciPy's z(x, y) spline, OCC's) is turned into the same plain form
 (degrees, clamped knots, control grid) and measured the same way: the distance of every data
 point to the surface by closest point — the 4 nearest samples of a dense sampling (6 per knot
-span and direction, so as fine on a 40,000- as on a 400-control-point surface) seed damped
-Newton descents, and the nearest foot point wins — in % of the data's bounding-box diagonal.
-geofit's rows also show the fit's own report (warm-started Newton), which this measure must
-match or undercut. Times are wall-clock and CPU seconds of the fit itself (geofit: the whole
+span and direction, so as fine on a 40,000- as on a 400-control-point surface) and the fit's own
+parameters of the point (geofit's foot points; for SciPy's and OCC's z(x, y) surfaces the
+parameters above the point) seed damped Newton descents, and the nearest foot point wins — in %
+of the data's bounding-box diagonal. geofit's rows also show the fit's own report
+(warm-started Newton from its parameters), which this measure must match or undercut. Times are wall-clock and CPU seconds of the fit itself (geofit: the whole
 process, reading the file included; OCC: resampling to its grid plus its fit).
 
     pip install -r scripts/bench-requirements.txt
@@ -79,25 +80,42 @@ class Surface:
         out = (br[:-1, None] + (br[1:] - br[:-1])[:, None] * inner[None, :]).ravel()
         return np.clip(np.append(out, hi), lo, hi)
 
-    def distances(self, pts, per_span=6, starts=4, iters=10):
+    def distances(self, pts, seeds=None, per_span=6, starts=4, iters=10):
         """Distance of every point to the surface: the `starts` nearest of a dense sampling
-        (`per_span` samples per knot span and direction, through a k-d tree) seed a damped
-        Newton descent on the squared distance (clamped to the domain), and the nearest foot
-        point wins. Returns (distances, (u, v) of the foot points)."""
+        (`per_span` samples per knot span and direction, through a k-d tree), and the fit's own
+        parameters of the points (`seeds`, when known), seed damped Newton descents on the
+        squared distance (clamped to the domain); the nearest foot point wins. Returns
+        (distances, (u, v) of the foot points)."""
         us = self.sample_params(self.tu, self.p, self.u0, self.u1, per_span)
         vs = self.sample_params(self.tv, self.q, self.v0, self.v1, per_span)
         grid = np.stack(np.meshgrid(us, vs, indexing="ij"), -1).reshape(-1, 2)
         tree = cKDTree(self.ev(grid))
         _, idx = tree.query(pts, k=starts)
         idx = idx.reshape(len(pts), -1)
+        inits = [grid[idx[:, s]] for s in range(idx.shape[1])]
+        if seeds is not None:
+            lo, hi = np.array([self.u0, self.v0]), np.array([self.u1, self.v1])
+            inits.append(np.clip(np.asarray(seeds, float), lo, hi))
         best_d = np.full(len(pts), np.inf)
         best_uv = np.zeros((len(pts), 2))
-        for s in range(idx.shape[1]):
-            uv, d = self.newton(pts, grid[idx[:, s]].copy(), iters)
+        for init in inits:
+            uv, d = self.newton(pts, init.copy(), iters)
             better = d < best_d
             best_d = np.where(better, d, best_d)
             best_uv[better] = uv[better]
         return best_d, best_uv
+
+    def graph_seeds(self, pts):
+        """For a z(x, y) surface (x depending on u only, y on v only, both increasing): the
+        parameters (u, v) straight above each point — the parameters that such a fit used."""
+        us = self.sample_params(self.tu, self.p, self.u0, self.u1, 16)
+        vs = self.sample_params(self.tv, self.q, self.v0, self.v1, 16)
+        vm, um = 0.5 * (self.v0 + self.v1), 0.5 * (self.u0 + self.u1)
+        xs = self.ev(np.stack([us, np.full_like(us, vm)], 1))[:, 0]
+        ys = self.ev(np.stack([np.full_like(vs, um), vs], 1))[:, 1]
+        if not (np.all(np.diff(xs) > 0) and np.all(np.diff(ys) > 0)):
+            return None
+        return np.stack([np.interp(pts[:, 0], xs, us), np.interp(pts[:, 1], ys, vs)], 1)
 
     def newton(self, pts, uv, iters):
         """Damped Newton on |S(u, v) − p|² from `uv`, clamped to the domain; (uv, distance)."""
@@ -172,6 +190,7 @@ def run_geofit(binary, data, extra):
         s = json.load(open(sj))
     ctrl = np.array(s["control_points"]).reshape(s["control_points_u"], s["control_points_v"], 3)
     surf = Surface(s["knots_u"], s["knots_v"], s["degree_u"], s["degree_v"], ctrl)
+    surf.seeds = np.array(s["parameters"])
     cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
     return surf, report, wall, cpu
 
@@ -271,7 +290,10 @@ def main():
     rows = []
 
     def row(name, ctrl, surf, wall, cpu, note=""):
-        emax, erms, eavg = stats(surf.distances(pts)[0], diag)
+        seeds = getattr(surf, "seeds", None)
+        if seeds is None:
+            seeds = surf.graph_seeds(pts)
+        emax, erms, eavg = stats(surf.distances(pts, seeds)[0], diag)
         rows.append((name, ctrl, emax, erms, eavg, wall, cpu, note))
         print(f"{name:34s} {ctrl:6d}  E_max {emax:6.3f}  E_rms {erms:6.4f}  E_avg {eavg:6.4f}  "
               f"{wall:7.2f} s / {cpu:6.2f} s  {note}", flush=True)

@@ -174,6 +174,9 @@ struct SurfaceJson<'a> {
     control_points_v: usize,
     /// Row-major in u: index i · control_points_v + j.
     control_points: Vec<[f64; 3]>,
+    /// The fit's foot-point parameters (u, v) of every data point, in data order (a
+    /// benchmark's closest-point search can start from them).
+    parameters: &'a [[f64; 2]],
 }
 
 /// Reads the file, fits, prints the report (JSON) and writes the requested files.
@@ -202,7 +205,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
     let degree = args.degree.unwrap_or(3);
     let tol_max = common.tol_max.unwrap_or(0.1);
     let max_ctrl = common.max_control.unwrap_or(40_000);
-    let (report, surface) = match args.method.unwrap_or(Method::LeastSquares) {
+    let (report, surface, parameters) = match args.method.unwrap_or(Method::LeastSquares) {
         Method::LeastSquares => {
             let d = LsqSurfaceOptions::default();
             let opts = d
@@ -236,6 +239,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
             (
                 report_of(base, "least-squares", fitter.surface(), fitter.num_folded()),
                 fitter.surface().clone(),
+                fitter.parameters().to_vec(),
             )
         }
         Method::Geometric => {
@@ -266,6 +270,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
             (
                 report_of(base, "geometric", fitter.surface(), fitter.num_folded()),
                 fitter.surface().clone(),
+                fitter.parameters().to_vec(),
             )
         }
     };
@@ -300,7 +305,8 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
         std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     if let Some(path) = &args.surface_json {
-        let json = serde_json::to_string(&surface_json(&surface)).map_err(|e| e.to_string())?;
+        let json = serde_json::to_string(&surface_json(&surface, &parameters))
+            .map_err(|e| e.to_string())?;
         std::fs::write(path, json).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     Ok(())
@@ -377,7 +383,7 @@ fn report_of(
     }
 }
 
-fn surface_json(s: &BSplineSurface) -> SurfaceJson<'_> {
+fn surface_json<'a>(s: &'a BSplineSurface, parameters: &'a [[f64; 2]]) -> SurfaceJson<'a> {
     let (nu, nv) = s.num_control();
     SurfaceJson {
         degree_u: s.knots_u().degree(),
@@ -387,5 +393,6 @@ fn surface_json(s: &BSplineSurface) -> SurfaceJson<'_> {
         control_points_u: nu,
         control_points_v: nv,
         control_points: s.control_points().iter().map(|p| p.to_array()).collect(),
+        parameters,
     }
 }
