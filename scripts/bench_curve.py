@@ -102,6 +102,22 @@ def occ_fit(points, diag, tol):
     return r[0], r[1], r[2], f"PointsToBSpline C2 deg {r[3]} Tol3D {tol3d:.3g} (open, seam point repeated)"
 
 
+def corner_jumps(spline, knots, degree):
+    """Angle (degrees) between the one-sided tangents at every interior knot of multiplicity
+    `degree` (a C0 corner knot): a corner kept sharp turns by about the data's angle."""
+    t = np.array(knots)
+    a, b = t[degree], t[-degree - 1]
+    values, counts = np.unique(t[(t > a) & (t < b)], return_counts=True)
+    d = spline.derivative()
+    eps = 1e-9 * (b - a)
+    out = []
+    for u in values[counts >= degree]:
+        t1, t2 = d(u - eps), d(u + eps)
+        cos = np.dot(t1, t2) / (np.linalg.norm(t1) * np.linalg.norm(t2))
+        out.append(float(np.degrees(np.arccos(np.clip(cos, -1, 1)))))
+    return out
+
+
 def geofit_fit(section, method, diag, points, tol):
     exe = REPO / "target" / "release" / "geofit"
     if not exe.exists():
@@ -119,6 +135,9 @@ def geofit_fit(section, method, diag, points, tol):
     note = f"{r['iterations']} iterations, own E_max {r['e_max_pct']:.5f} %"
     if method == "knots":
         note += f", {r['details']['corners']} corner / {r['details']['features']} multiple knots"
+        jumps = corner_jumps(spline, c["knots"], c["degree"])
+        if jumps:
+            note += f", tangent turns {min(jumps):.1f}–{max(jumps):.1f}° at the corner knots"
     return r["control_points"], emax_pct(points, poly, diag), r["fit_s"], note
 
 

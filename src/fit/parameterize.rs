@@ -340,9 +340,8 @@ fn detect_folds(
     let gap = gap_cells * cell;
     let cols = ((size_u / cell).ceil() as usize).clamp(1, 1 << 15);
     let rows = ((size_v / cell).ceil() as usize).clamp(1, 1 << 15);
-    // Points ordered by (cell, depth, index): each cell's members are one run of the order,
-    // depth-sorted. One sort instead of a hash map of per-cell lists (the view search runs
-    // this for 17 directions).
+    // Points grouped by cell with a counting sort (one pass, no comparisons: the view search
+    // runs this for 17 directions), then each cell's few members sorted by depth.
     let key: Vec<usize> = uv
         .iter()
         .map(|[u, v]| {
@@ -351,16 +350,27 @@ fn detect_folds(
             cu * rows + cv
         })
         .collect();
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_unstable_by(|&a, &b| {
-        key[a]
-            .cmp(&key[b])
-            .then(depth[a].total_cmp(&depth[b]))
-            .then(a.cmp(&b))
-    });
+    let mut start = vec![0usize; cols * rows + 1];
+    for &k in &key {
+        start[k + 1] += 1;
+    }
+    for c in 0..cols * rows {
+        start[c + 1] += start[c];
+    }
+    let mut order = vec![0usize; n];
+    let mut next = start.clone();
+    for (i, &k) in key.iter().enumerate() {
+        order[next[k]] = i;
+        next[k] += 1;
+    }
     let mut folded = vec![false; n];
-    for members in order.chunk_by(|&a, &b| key[a] == key[b]) {
-        mark_minor_layers(members, depth, gap, &mut folded);
+    for c in 0..cols * rows {
+        let members = &mut order[start[c]..start[c + 1]];
+        if members.len() > 1 {
+            // Stable: equal depths keep index order.
+            members.sort_by(|&a, &b| depth[a].total_cmp(&depth[b]));
+            mark_minor_layers(members, depth, gap, &mut folded);
+        }
     }
     folded
 }
