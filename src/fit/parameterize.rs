@@ -467,6 +467,38 @@ fn principal_axes(points: &[Point3], center: Point3) -> ([f64; 3], [Vec3; 3]) {
 mod tests {
     use super::*;
 
+    /// A 60 × 60 sheet at z = 0 and, inside its right quarter, a sparse 6 × 12 flap at
+    /// z = 0.5: seen along z, exactly the flap's points lie on a second (smaller) layer.
+    fn sheet_with_flap() -> Vec<Point3> {
+        let mut pts: Vec<Point3> = (0..3600)
+            .map(|k| Point3::new((k / 60) as f64 / 59.0, (k % 60) as f64 / 59.0, 0.0))
+            .collect();
+        pts.extend((0..72).map(|k| {
+            let (x, y) = ((k / 12) as f64 / 5.0, (k % 12) as f64 / 11.0);
+            Point3::new(0.75 + 0.24 * x, 0.01 + 0.98 * y, 0.5)
+        }));
+        pts
+    }
+
+    #[test]
+    fn the_flap_of_a_fold_is_detected() {
+        let pts = sheet_with_flap();
+        let opts = ParamOptions::default().with_view(Vec3::Z);
+        let param = parameterize(&pts, &opts).expect("parameterised");
+        assert_eq!(param.num_folded, 72);
+        assert!(param.folded[3600..].iter().all(|&f| f));
+        let fail = opts.with_fold_policy(FoldPolicy::Fail);
+        assert!(matches!(
+            parameterize(&pts, &fail),
+            Err(FitError::FoldedProjection { count: 72, .. })
+        ));
+        // The flat sheet alone has no folds.
+        assert_eq!(
+            parameterize(&pts[..3600], &opts).expect("flat").num_folded,
+            0
+        );
+    }
+
     #[test]
     fn layers_split_at_gaps() {
         let depth = [0.0, 0.1, 0.2, 5.0, 5.1];
