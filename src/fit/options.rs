@@ -95,7 +95,10 @@ pub struct SubdivFitOptions {
     pub refine: bool,
     /// Refine at the latest after this many iterations without meeting the tolerances [6].
     pub refine_interval: usize,
-    /// One refinement adds at most this fraction of the current control points [0.5].
+    /// One refinement adds at most this fraction of the current control points [3]. A high cap
+    /// lets the out-of-tolerance faces decide how much to split: on the bunny (612 initial
+    /// points, 7,049 budget) 0.5 took 32 iterations and ten refinements, 3 takes 21 and seven,
+    /// with the same final control count.
     pub refine_growth: f64,
     /// Refine earlier when one iteration lowers E_rms by less than this fraction [0.05].
     pub stall_ratio: f64,
@@ -126,7 +129,7 @@ impl Default for SubdivFitOptions {
             max_control: None,
             refine: true,
             refine_interval: 6,
-            refine_growth: 0.5,
+            refine_growth: 3.0,
             stall_ratio: 0.05,
             remesh: true,
             weighting: Weighting::default(),

@@ -118,12 +118,14 @@ pub struct Args {
     /// Acceleration [default: cg with basis weights, none with patent weights].
     #[arg(long, value_enum)]
     accel: Option<AccelArg>,
-    /// With --accel cg: weight of the tangential error relative to the normal one (0, 1].
-    #[arg(long, default_value_t = 0.1)]
-    tangent_weight: f64,
-    /// One refinement adds at most this fraction of the current control points.
-    #[arg(long, default_value_t = 0.5)]
-    refine_growth: f64,
+    /// With --accel cg: weight of the tangential error relative to the normal one, in (0, 1]
+    /// [default: 0.1].
+    #[arg(long)]
+    tangent_weight: Option<f64>,
+    /// One refinement adds at most this fraction of the current control points [default: 3,
+    /// so the out-of-tolerance faces decide; the budget caps it].
+    #[arg(long)]
+    refine_growth: Option<f64>,
     /// Write the report (setup, final errors, times, per-iteration history) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -166,9 +168,13 @@ impl Args {
                     AccelArg::Anderson => Acceleration::Anderson { depth: 5 },
                     AccelArg::Cg => Acceleration::Cg { inner: 8 },
                 },
-            )
-            .with_tangent_weight(self.tangent_weight);
-        options.refine_growth = self.refine_growth;
+            );
+        if let Some(w) = self.tangent_weight {
+            options = options.with_tangent_weight(w);
+        }
+        if let Some(g) = self.refine_growth {
+            options.refine_growth = g;
+        }
         options
     }
 
