@@ -223,12 +223,21 @@ fn loop_beta(k: usize) -> f64 {
 /// without raising R(M) by more than 2. Flips need the two triangles to be nearly coplanar (so
 /// the shape is kept), and both new triangles to keep the orientation (no fold-over).
 /// Deterministic: edges are visited in sorted order. Returns the number of flips.
-pub fn improve_by_flips(mesh: &mut PolyMesh, passes: usize) -> Result<usize, FitError> {
+///
+/// Only edges next to a vertex numbered `first_new` or higher are considered (an end or an
+/// opposite corner): after a split those are the new midpoints, so the flips stay in the region
+/// the split changed, where the rest of the mesh was already improved by earlier passes (and
+/// a refinement of a few faces does not pay for a pass over the whole mesh). 0 considers all.
+pub fn improve_by_flips(
+    mesh: &mut PolyMesh,
+    passes: usize,
+    first_new: u32,
+) -> Result<usize, FitError> {
     let mut tris = triangles_of(mesh)?;
     let pos = mesh.positions().to_vec();
     let mut total = 0;
     for _ in 0..passes {
-        let flips = flip_pass(&pos, &mut tris);
+        let flips = flip_pass(&pos, &mut tris, first_new);
         total += flips;
         if flips == 0 {
             break;
@@ -242,7 +251,7 @@ pub fn improve_by_flips(mesh: &mut PolyMesh, passes: usize) -> Result<usize, Fit
     Ok(total)
 }
 
-fn flip_pass(pos: &[Point3], tris: &mut [[u32; 3]]) -> usize {
+fn flip_pass(pos: &[Point3], tris: &mut [[u32; 3]], first_new: u32) -> usize {
     let faces_on = edge_faces(tris);
     let mut valence = vec![0i64; pos.len()];
     let mut on_boundary = vec![false; pos.len()];
@@ -262,7 +271,12 @@ fn flip_pass(pos: &[Point3], tris: &mut [[u32; 3]]) -> usize {
         let &[(f1, c1), (f2, c2)] = faces.as_slice() else {
             continue;
         };
-        if touched[f1] || touched[f2] || c1 == c2 || faces_on.contains_key(&edge(c1, c2)) {
+        if a.max(b).max(c1).max(c2) < first_new
+            || touched[f1]
+            || touched[f2]
+            || c1 == c2
+            || faces_on.contains_key(&edge(c1, c2))
+        {
             continue;
         }
         // Orient: f1 = (x, y, c) with x→y, f2 = (y, x, d).
@@ -405,7 +419,8 @@ mod tests {
             Point3::new(5.0, -0.3, 0.0),
         ];
         let mut m = PolyMesh::try_new(p, [[0, 1, 2], [1, 0, 3]]).expect("valid");
-        assert_eq!(improve_by_flips(&mut m, 3).expect("flips"), 1);
+        assert_eq!(improve_by_flips(&mut m, 3, 4).expect("none new"), 0);
+        assert_eq!(improve_by_flips(&mut m, 3, 3).expect("flips"), 1);
         check_manifold(&m).expect("manifold");
         assert!(m.faces().all(|f| f.contains(&2) && f.contains(&3)));
     }

@@ -8,7 +8,7 @@ use super::subdiv::{ControlSurface, SubdivFitter};
 use super::{FitError, SubdivFitOptions};
 use crate::geom::Point3;
 use crate::mesh::{ControlMesh, PolyMesh};
-use crate::subdiv::{quadrangulate, Scheme, SubdivSurface};
+use crate::subdiv::{quadrangulate, LimitSurface, Scheme, SubdivSurface};
 
 /// The limit surface of `control` under `scheme`; quad schemes accept any polygon mesh and turn
 /// it into quads first (one Catmull–Clark step) when it is not all quads.
@@ -75,7 +75,7 @@ impl ControlSurface for SubdivSurface {
 
     fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
         match self.scheme() {
-            Scheme::Loop => improve_by_flips(control, 3),
+            Scheme::Loop => improve_by_flips(control, 3, self.control_points().len() as u32),
             _ => Ok(0),
         }
     }

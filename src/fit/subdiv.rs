@@ -33,8 +33,10 @@ pub trait ControlSurface: LimitSurface + Sized {
     /// around them, placing new points so that the limit surface changes as little as possible.
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError>;
 
-    /// Local remeshing after a refinement (edge flips for triangle schemes). Returns the number
-    /// of changes; the default makes none.
+    /// Local remeshing after a refinement (edge flips for triangle schemes) of `control`, the
+    /// result of [`ControlSurface::refine_control`] on this surface's mesh (its vertices past
+    /// this surface's control points are the new ones). Returns the number of changes; the
+    /// default makes none.
     fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
         let _ = control;
         Ok(0)
