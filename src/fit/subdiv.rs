@@ -357,10 +357,11 @@ impl<S: ControlSurface> SubdivFitter<S> {
         chosen
     }
 
-    /// Samples per patch edge for the spatial index: about two samples per data point in all,
-    /// at most the option.
+    /// Samples per patch edge for the spatial index: about one sample per data point in all, at
+    /// most the option (two per point made the bunny fit 6 % slower for the same result: the
+    /// index only seeds Newton, which walks across patches from there).
     fn index_resolution(&self) -> usize {
-        let per_patch = 2.0 * self.data.len() as f64 / self.surface.num_patches().max(1) as f64;
+        let per_patch = self.data.len() as f64 / self.surface.num_patches().max(1) as f64;
         (per_patch.sqrt().ceil() as usize).clamp(1, self.options.index_resolution)
     }
 
