@@ -51,9 +51,19 @@ pub enum Acceleration {
     },
 }
 
+impl Acceleration {
+    /// CG with the default number of steps per iteration, 12: on the bunny (612 initial
+    /// control points, 7,049 budget) 8 steps took 21 iterations, 12 take 18 with fewer control
+    /// points (6,908) and about 20 % less time; 5 steps took 97 iterations, 16–24 no fewer
+    /// than 12.
+    pub const fn cg() -> Acceleration {
+        Acceleration::Cg { inner: 12 }
+    }
+}
+
 impl Default for Acceleration {
     fn default() -> Self {
-        Acceleration::Cg { inner: 8 }
+        Acceleration::cg()
     }
 }
 
@@ -107,7 +117,7 @@ pub struct SubdivFitOptions {
     pub remesh: bool,
     /// Error-vector weighting [basis].
     pub weighting: Weighting,
-    /// Acceleration [CG, 8 steps per iteration; measured fastest on the bunny].
+    /// Acceleration [CG, 12 steps per iteration; measured fastest on the bunny].
     pub acceleration: Acceleration,
     /// Undo and halve a move that raises E_rms, and reset the acceleration [true].
     pub damping: bool,

@@ -133,7 +133,7 @@ impl JsFitOptions {
             "none" => Ok(Acceleration::None),
             "relax" => Ok(Acceleration::Relax { omega: 1.5 }),
             "anderson" => Ok(Acceleration::Anderson { depth: 5 }),
-            "cg" => Ok(Acceleration::Cg { inner: 8 }),
+            "cg" => Ok(Acceleration::cg()),
             other => Err(JsError::new(&format!(
                 "option acceleration: '{other}' is not one of 'none', 'relax', 'anderson', 'cg'"
             ))),

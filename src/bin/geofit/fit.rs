@@ -45,7 +45,7 @@ pub enum AccelArg {
     Relax,
     /// Anderson acceleration over the last 5 iterates.
     Anderson,
-    /// 8 conjugate-gradient steps per iteration on the frozen foot parameters (basis weights).
+    /// 12 conjugate-gradient steps per iteration on the frozen foot parameters (basis weights).
     Cg,
 }
 
@@ -166,7 +166,7 @@ impl Args {
                     AccelArg::None => Acceleration::None,
                     AccelArg::Relax => Acceleration::Relax { omega: 1.5 },
                     AccelArg::Anderson => Acceleration::Anderson { depth: 5 },
-                    AccelArg::Cg => Acceleration::Cg { inner: 8 },
+                    AccelArg::Cg => Acceleration::cg(),
                 },
             );
         if let Some(w) = self.tangent_weight {
