@@ -73,6 +73,10 @@ impl ControlSurface for SubdivSurface {
         }
     }
 
+    fn kept_patch(&self, patch: u32) -> Option<u32> {
+        SubdivSurface::kept_patch(self, patch)
+    }
+
     fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
         match self.scheme() {
             Scheme::Loop => improve_by_flips(control, 3, self.control_points().len() as u32),

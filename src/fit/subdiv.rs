@@ -33,6 +33,14 @@ pub trait ControlSurface: LimitSurface + Sized {
     /// around them, placing new points so that the limit surface changes as little as possible.
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError>;
 
+    /// The patch of the surface this one was rebuilt from ([`ControlSurface::rebuild`]) that
+    /// `patch` is an exact copy of, if any: foot points there carry over without a search. The
+    /// default knows of none.
+    fn kept_patch(&self, patch: u32) -> Option<u32> {
+        let _ = patch;
+        None
+    }
+
     /// Local remeshing after a refinement (edge flips for triangle schemes) of `control`, the
     /// result of [`ControlSurface::refine_control`] on this surface's mesh (its vertices past
     /// this surface's control points are the new ones). Returns the number of changes; the
@@ -411,10 +419,21 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .collect()
     }
 
-    /// Foot points after a refinement: a point whose patch lies on a face the refinement left
-    /// as it was (same corners, same order) starts Newton from its old parameters on that face;
-    /// the others are searched from the spatial index.
+    /// Foot points after a refinement: a point on a patch the rebuild kept as it was keeps its
+    /// foot point; a point whose patch lies on a face the refinement left as it was (same
+    /// corners, same order) starts Newton from its old parameters on that face; the others are
+    /// searched from the spatial index.
     fn carry_feet_over(&mut self, old: &[Vec<u32>], refined: &PolyMesh) -> Result<(), FitError> {
+        let mut copy_of = vec![u32::MAX; old.len()];
+        for p in 0..self.surface.num_patches() as u32 {
+            if let Some(slot) = self
+                .surface
+                .kept_patch(p)
+                .and_then(|k| copy_of.get_mut(k as usize))
+            {
+                *slot = p;
+            }
+        }
         let mut face_patch = std::collections::HashMap::new();
         for p in (0..self.surface.num_patches() as u32).rev() {
             let f = self.surface.patch_face(p);
@@ -425,6 +444,10 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let opts = self.options.newton;
         for i in 0..self.data.len() {
             let (p, prev) = (self.data[i], self.feet[i].param);
+            if let Some(&patch) = copy_of.get(prev.patch as usize).filter(|&&c| c != u32::MAX) {
+                self.feet[i].param.patch = patch;
+                continue;
+            }
             let kept = old
                 .get(prev.patch as usize)
                 .and_then(|corners| face_patch.get(corners));

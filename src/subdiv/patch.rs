@@ -621,11 +621,19 @@ impl Graph {
         &self.power
     }
 
-    /// The shortcut of the patch shape `node` (built on first request) and the length of a
-    /// patch's cached data for it.
-    pub fn shortcut(&mut self, node: u32) -> (u32, usize) {
+    /// Length of a patch's cached data: power coefficients for a `direct` patch, shortcut
+    /// `shortcut`'s data otherwise.
+    pub fn cache_len(&self, direct: bool, shortcut: u32) -> usize {
+        match direct {
+            true => self.power.len(),
+            false => self.shortcuts.get(shortcut as usize).map_or(0, |s| s.len),
+        }
+    }
+
+    /// The shortcut of the patch shape `node`, built on first request.
+    pub fn shortcut(&mut self, node: u32) -> u32 {
         if let Some(&id) = self.shortcut_of.get(&node) {
-            return (id, self.shortcuts[id as usize].len);
+            return id;
         }
         let k = match &self.nodes[node as usize] {
             Node::Regular { k, .. } | Node::Split { k, .. } => *k,
@@ -654,7 +662,7 @@ impl Graph {
         let id = self.shortcuts.len() as u32;
         self.shortcuts.push(Shortcut { cells, k, len });
         self.shortcut_of.insert(node, id);
-        (id, len)
+        id
     }
 
     /// Appends the cell of `node` at `depth`, whose local points are `acc` (`k_node × k`) times

@@ -39,6 +39,9 @@ pub struct SubdivSurface {
     /// Limit stencil of every control vertex (limit masks), flattened.
     limit_starts: Vec<u32>,
     limit_weights: Vec<(u32, f64)>,
+    /// Per patch, the patch of the surface this one was rebuilt from that it copies
+    /// ([`SubdivSurface::kept_patch`]).
+    kept: Vec<Option<u32>>,
 }
 
 /// The (face, first corner) of every patch of a primal scheme: one per face.
@@ -124,19 +127,86 @@ pub(crate) fn topo_of(mesh: &ControlMesh) -> Topo {
 impl SubdivSurface {
     /// The limit surface of `mesh` under `scheme` (Loop needs triangles, Catmull–Clark quads).
     pub fn try_new(scheme: Scheme, mesh: ControlMesh) -> Result<SubdivSurface, SubdivError> {
-        SubdivSurface::with_graph(scheme, mesh, Graph::new(scheme))
+        let mut surface = SubdivSurface::with_graph(scheme, mesh, Graph::new(scheme), |_| None)?;
+        surface.fill_cache_from(None);
+        Ok(surface)
     }
 
     /// The limit surface of the same scheme over a new control mesh (after refinement): the
-    /// patch shapes already analysed are reused, so only new shapes are subdivided.
+    /// patch shapes already analysed are reused, so only new shapes are subdivided, and a patch
+    /// the new mesh leaves as it was (see [`SubdivSurface::kept_patch`]) is copied, not rebuilt.
     pub fn with_mesh(&self, mesh: ControlMesh) -> Result<SubdivSurface, SubdivError> {
-        SubdivSurface::with_graph(self.scheme, mesh, self.graph.clone())
+        let kept = self.kept_patches(&mesh);
+        let mut surface = SubdivSurface::with_graph(self.scheme, mesh, self.graph.clone(), |p| {
+            let old = *self.patches.get(kept.get(p).copied().flatten()? as usize)?;
+            Some((
+                old,
+                &self.ctrl[old.start as usize..(old.start + old.len) as usize],
+            ))
+        })?;
+        surface.kept = kept;
+        surface.fill_cache_from(Some(self));
+        Ok(surface)
     }
 
-    fn with_graph(
+    /// The patch of the surface this one was made from ([`SubdivSurface::with_mesh`]) that
+    /// `patch` is an exact copy of: same face corners in the same order, same neighbourhood,
+    /// same control points. Foot points on such a patch are still foot points.
+    pub fn kept_patch(&self, patch: u32) -> Option<u32> {
+        self.kept.get(patch as usize).copied().flatten()
+    }
+
+    /// For every patch over `mesh`, the patch of `self` it copies, if any. A primal patch
+    /// depends on the faces around its corners, so it is kept when every face around every
+    /// corner is a face of `self` (same corners, same order) and its control points have not
+    /// moved; a refinement changes a few regions and leaves the rest of the mesh alone.
+    /// Doo–Sabin patches (not one per face) are always rebuilt: the list is empty.
+    fn kept_patches(&self, mesh: &ControlMesh) -> Vec<Option<u32>> {
+        let n = mesh.num_faces();
+        if self.doo_sabin.is_some() {
+            return Vec::new();
+        }
+        let corners = |m: &ControlMesh, f: u32| {
+            let mut key = [u32::MAX; 4];
+            for (k, v) in key.iter_mut().zip(m.face_vertices(f)) {
+                *k = v;
+            }
+            key
+        };
+        let old: std::collections::HashMap<[u32; 4], u32> = (0..self.mesh.num_faces() as u32)
+            .map(|f| (corners(&self.mesh, f), f))
+            .collect();
+        let same: Vec<Option<u32>> = (0..n as u32)
+            .map(|f| old.get(&corners(mesh, f)).copied())
+            .collect();
+        let mut touched = vec![false; mesh.num_vertices()];
+        for f in (0..n as u32).filter(|&f| same[f as usize].is_none()) {
+            for v in mesh.face_vertices(f) {
+                touched[v as usize] = true;
+            }
+        }
+        let (old_pts, new_pts) = (self.mesh.positions(), mesh.positions());
+        let unmoved = |i: u32| old_pts.get(i as usize) == new_pts.get(i as usize);
+        (0..n as u32)
+            .map(|f| {
+                let old_f = same[f as usize]?;
+                let p = self.patches.get(old_f as usize)?;
+                let local = self
+                    .ctrl
+                    .get(p.start as usize..(p.start + p.len) as usize)?;
+                let clean = mesh.face_vertices(f).all(|v| !touched[v as usize]);
+                (clean && local.iter().all(|&i| unmoved(i))).then_some(old_f)
+            })
+            .collect()
+    }
+
+    /// Builds the patches of `mesh`, without their cached data; `copy(patch)` gives a patch of
+    /// the previous surface and its control indices to take as they are.
+    fn with_graph<'a>(
         scheme: Scheme,
         mesh: ControlMesh,
         mut graph: Graph,
+        copy: impl Fn(usize) -> Option<(Patch, &'a [u32])>,
     ) -> Result<SubdivSurface, SubdivError> {
         let needed = match scheme {
             Scheme::Loop => 3,
@@ -166,6 +236,16 @@ impl SubdivSurface {
         };
         let mut cache_len = 0;
         for patch in 0..sites.len() {
+            if let Some((old, local)) = copy(patch) {
+                patches.push(Patch {
+                    start: ctrl.len() as u32,
+                    cache: cache_len as u32,
+                    ..old
+                });
+                ctrl.extend_from_slice(local);
+                cache_len += graph.cache_len(old.direct, old.shortcut);
+                continue;
+            }
             let (nb, source) = match &doo_sabin {
                 Some(ds) => {
                     let (f, v) = ds.sites[patch];
@@ -185,12 +265,13 @@ impl SubdivSurface {
             };
             let node = graph.add(nb, patch)?;
             let start = ctrl.len() as u32;
-            let (picks, direct, shortcut, data) = match graph.direct_picks(node) {
-                Some(picks) => (picks, true, 0, graph.power().len()),
-                None => {
-                    let (id, len) = graph.shortcut(node);
-                    ((0..source.len() as u32).collect(), false, id, len)
-                }
+            let (picks, direct, shortcut) = match graph.direct_picks(node) {
+                Some(picks) => (picks, true, 0),
+                None => (
+                    (0..source.len() as u32).collect(),
+                    false,
+                    graph.shortcut(node),
+                ),
             };
             ctrl.extend(picks.iter().map(|&p| source[p as usize]));
             patches.push(Patch {
@@ -200,7 +281,7 @@ impl SubdivSurface {
                 shortcut,
                 cache: cache_len as u32,
             });
-            cache_len += data;
+            cache_len += graph.cache_len(direct, shortcut);
         }
         let mut limit_starts = vec![0u32];
         let mut limit_weights = Vec::new();
@@ -217,7 +298,7 @@ impl SubdivSurface {
             limit_weights.extend(s.ok_or(SubdivError::Unevaluable { patch: 0 })?);
             limit_starts.push(limit_weights.len() as u32);
         }
-        let mut surface = SubdivSurface {
+        let surface = SubdivSurface {
             scheme,
             mesh,
             graph,
@@ -228,17 +309,30 @@ impl SubdivSurface {
             cache: Vec::with_capacity(cache_len),
             limit_starts,
             limit_weights,
+            kept: Vec::new(),
         };
-        surface.fill_cache();
         Ok(surface)
     }
 
     /// Recomputes every patch's cached data from the current control points.
     fn fill_cache(&mut self) {
+        self.fill_cache_from(None);
+    }
+
+    /// Fills every patch's cached data: copied from `previous` for the patches kept from it
+    /// (their control points are the same), computed from the control points for the others.
+    fn fill_cache_from(&mut self, previous: Option<&SubdivSurface>) {
         self.cache.clear();
         let pts = self.mesh.positions();
         let mut local = Vec::with_capacity(super::patch::MAX_LOCAL);
-        for p in &self.patches {
+        for (i, p) in self.patches.iter().enumerate() {
+            let kept = previous.zip(self.kept.get(i).copied().flatten());
+            if let Some((old, k)) = kept {
+                let start = old.patches[k as usize].cache as usize;
+                let len = self.graph.cache_len(p.direct, p.shortcut);
+                self.cache.extend_from_slice(&old.cache[start..start + len]);
+                continue;
+            }
             local.clear();
             let idx = &self.ctrl[p.start as usize..(p.start + p.len) as usize];
             local.extend(idx.iter().map(|&i| pts[i as usize]));
