@@ -191,7 +191,8 @@ pub(crate) fn biquadratic(u: f64, v: f64) -> Weights<9> {
 /// every basis function.
 #[derive(Clone)]
 pub(crate) struct PowerBasis {
-    /// Exponents (a, b) of each monomial.
+    /// Exponents (a, b) of each monomial, grouped by `a` (evaluation sums each group in `v`
+    /// first, then combines the groups in `u`).
     pub exps: Vec<(usize, usize)>,
     /// Number of spline control points (12 box-spline, 16 bicubic, 9 biquadratic).
     pub points: usize,
@@ -241,8 +242,8 @@ impl PowerBasis {
         };
         let mut exps = Vec::with_capacity(n * n);
         let mut to_power = vec![0.0; n * n * n * n];
-        for b in 0..n {
-            for a in 0..n {
+        for a in 0..n {
+            for b in 0..n {
                 let m = exps.len();
                 exps.push((a, b));
                 for j in 0..n {
@@ -272,17 +273,34 @@ impl PowerBasis {
     }
 
     /// Limit point and derivatives at (u, v) from power coefficients.
+    ///
+    /// Factored as Σ_a u^a (Σ_b c_ab v^b): the inner sums and their first two v-derivatives
+    /// take three multiply-adds per monomial, and each power of u then combines them into the
+    /// six outputs, instead of six products per monomial (this is the innermost loop of the
+    /// foot-point search).
     pub fn eval(&self, coeffs: &[Vec3], u: f64, v: f64) -> LimitEval {
         let (pu, pv) = (powers(u), powers(v));
         let mut e = LimitEval::default();
+        let add_row = |e: &mut LimitEval, a: usize, s: [Vec3; 3]| {
+            e.point += s[0] * pu[0][a];
+            e.du += s[0] * pu[1][a];
+            e.duu += s[0] * pu[2][a];
+            e.dv += s[1] * pu[0][a];
+            e.duv += s[1] * pu[1][a];
+            e.dvv += s[2] * pu[0][a];
+        };
+        let mut row = self.exps.first().map_or(0, |&(a, _)| a);
+        let mut s = [Vec3::ZERO; 3];
         for (&(a, b), &c) in self.exps.iter().zip(coeffs) {
-            e.point += c * (pu[0][a] * pv[0][b]);
-            e.du += c * (pu[1][a] * pv[0][b]);
-            e.dv += c * (pu[0][a] * pv[1][b]);
-            e.duu += c * (pu[2][a] * pv[0][b]);
-            e.duv += c * (pu[1][a] * pv[1][b]);
-            e.dvv += c * (pu[0][a] * pv[2][b]);
+            if a != row {
+                add_row(&mut e, row, s);
+                (row, s) = (a, [Vec3::ZERO; 3]);
+            }
+            s[0] += c * pv[0][b];
+            s[1] += c * pv[1][b];
+            s[2] += c * pv[2][b];
         }
+        add_row(&mut e, row, s);
         e
     }
 
