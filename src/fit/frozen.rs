@@ -20,8 +20,12 @@ impl Stencils {
         params: impl Iterator<Item = SurfaceParam>,
     ) -> Stencils {
         let columns = surface.control_points().len();
-        let mut starts = vec![0];
-        let mut entries = Vec::new();
+        let rows = params.size_hint().0;
+        let mut starts = Vec::with_capacity(rows + 1);
+        starts.push(0);
+        // A regular patch has 12 (Loop) or 16 (Catmull–Clark) weights: reserving for that
+        // avoids copying megabytes while the rows grow.
+        let mut entries = Vec::with_capacity(rows * 16);
         let mut row = Vec::new();
         for at in params {
             row.clear();
@@ -47,19 +51,25 @@ impl Stencils {
         self.starts.len() - 1
     }
 
-    /// out_i = Σ_j B_ij x_j.
-    fn apply(&self, x: &[Vec3], out: &mut [Vec3]) {
-        for (i, o) in out.iter_mut().enumerate().take(self.rows()) {
-            *o = self.row(i).iter().map(|&(j, w)| x[j as usize] * w).sum();
-        }
-    }
-
     /// out_j = Σ_i B_ij r_i.
     fn apply_transposed(&self, r: &[Vec3], out: &mut [Vec3]) {
         out.fill(Vec3::ZERO);
         for (i, ri) in r.iter().enumerate().take(self.rows()) {
             for &(j, w) in self.row(i) {
                 out[j as usize] += *ri * w;
+            }
+        }
+    }
+
+    /// out = Bᵀ M B x in one pass over the rows (each row's value is used right away, which
+    /// halves the memory traffic of applying B and Bᵀ in turn); `metric(i, v)` is M_i v.
+    fn apply_normal(&self, x: &[Vec3], metric: impl Fn(usize, Vec3) -> Vec3, out: &mut [Vec3]) {
+        out.fill(Vec3::ZERO);
+        for i in 0..self.rows() {
+            let row = self.row(i);
+            let t = metric(i, row.iter().map(|&(j, w)| x[j as usize] * w).sum());
+            for &(j, w) in row {
+                out[j as usize] += t * w;
             }
         }
     }
@@ -78,11 +88,10 @@ impl Stencils {
         steps: usize,
     ) -> Vec<Vec3> {
         let n = self.columns;
-        let metric = |r: &mut [Vec3]| {
-            for (v, nrm) in r.iter_mut().zip(normals) {
-                let along = *nrm * nrm.dot(*v);
-                *v = along + (*v - along) * tangent_weight;
-            }
+        let metric = |i: usize, v: Vec3| {
+            let nrm = normals.get(i).copied().unwrap_or_default();
+            let along = nrm * nrm.dot(v);
+            along + (v - along) * tangent_weight
         };
         let mut diag = vec![0.0; n];
         for &(j, w) in &self.entries {
@@ -97,17 +106,14 @@ impl Stencils {
         let dot = |a: &[Vec3], b: &[Vec3]| -> f64 { a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum() };
         let mut x = vec![Vec3::ZERO; n];
         let mut r = vec![Vec3::ZERO; n];
-        let mut me = e.to_vec();
-        metric(&mut me);
+        let me: Vec<Vec3> = e.iter().enumerate().map(|(i, &v)| metric(i, v)).collect();
         self.apply_transposed(&me, &mut r);
         let mut z = precondition(&r);
         let mut p = z.clone();
         let mut rz = dot(&r, &z);
-        let (mut bp, mut ap) = (vec![Vec3::ZERO; self.rows()], vec![Vec3::ZERO; n]);
+        let mut ap = vec![Vec3::ZERO; n];
         for _ in 0..steps {
-            self.apply(&p, &mut bp);
-            metric(&mut bp);
-            self.apply_transposed(&bp, &mut ap);
+            self.apply_normal(&p, metric, &mut ap);
             let pap = dot(&p, &ap);
             let alpha = rz / pap;
             if !(pap > 0.0 && alpha.is_finite()) {

@@ -26,8 +26,10 @@ const MAX_DEPTH: usize = 40;
 /// Extra levels allowed after moving to the sub-patch centre at [`MAX_DEPTH`].
 const EXTRA_DEPTH: usize = 24;
 /// Levels of local subdivision flattened into a [`Shortcut`]: a sample goes deeper with
-/// probability about 4^-depth, so almost every evaluation is one polynomial.
-const SHORTCUT_DEPTH: usize = 2;
+/// probability about 4^-depth, so almost every evaluation is one polynomial. Each level adds
+/// cached data that every control-point update refills: on the bunny fit, 3 levels made the
+/// foot points 20 % cheaper than 2 for a third more refilling; 4 cost more than they saved.
+const SHORTCUT_DEPTH: usize = 3;
 
 /// Affine map from a parent patch's parameters into a child's: `child = m · (p − origin)`.
 #[derive(Clone, Copy, Debug)]
