@@ -4,6 +4,7 @@
 //! Incidence lists (each vertex knows its faces) rather than half-edges, so that inputs with
 //! non-manifold edges or vertices are still represented; such places are simply never collapsed.
 
+use super::locality::Numbering;
 use super::quadric::Quadric;
 use crate::geom::{Point3, Vec3};
 
@@ -28,26 +29,60 @@ fn quality(a: Point3, b: Point3, c: Point3) -> f64 {
     }
 }
 
+/// A neighbour of a vertex and the id of the edge to it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Link {
+    pub(super) nbr: u32,
+    pub(super) edge: u32,
+}
+
+/// An edge with a single face, `a < b`: where a boundary penalty plane goes.
+pub(super) struct OpenEdge {
+    pub(super) a: u32,
+    pub(super) b: u32,
+    pub(super) face: u32,
+}
+
+/// A triangle of the working mesh, with what the fold-over test needs of it in one place (the
+/// test reads both for every face around a collapse, and they used to be two cache misses).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Face {
+    /// The vertices, in the input's orientation.
+    pub(super) corners: [u32; 3],
+    /// The unit normal in the input: a face may never turn against it, which catches
+    /// fold-overs built up by many small rotations.
+    ref_normal: Vec3,
+}
+
 /// The mesh being simplified.
 pub(super) struct Work {
     pub(super) pos: Vec<Point3>,
     pub(super) quadric: Vec<Quadric>,
-    pub(super) tris: Vec<[u32; 3]>,
+    pub(super) faces: Vec<Face>,
     pub(super) tri_alive: Vec<bool>,
-    /// Each face's unit normal in the input: a face may never turn against it, which catches
-    /// fold-overs built up by many small rotations.
-    ref_normal: Vec<Vec3>,
     /// Faces incident to each vertex; empty for removed or unreferenced vertices.
     pub(super) vfaces: Vec<Vec<u32>>,
+    /// Each vertex's neighbours sorted by index, with the ids of the edges to them: kept up to
+    /// date by [`Work::collapse`] so that the link condition needs no sorting, and edge ids
+    /// stay stable for the queue. Ids of removed edges are never reused.
+    pub(super) adj: Vec<Vec<Link>>,
+    /// Each edge's ends, lower index first (stale for removed edges).
+    pub(super) ends: Vec<[u32; 2]>,
+    /// Whether each vertex has an incident edge with a single face.
+    boundary: Vec<bool>,
     /// Number of vertices with at least one face.
     pub(super) live: usize,
-    scratch_u: Vec<u32>,
-    scratch_v: Vec<u32>,
+    /// How working indices relate to the input's (see [`Work::renumber`]).
+    pub(super) numbering: Numbering,
+    scratch: Vec<u32>,
+    /// A spare link list, so that rebuilding `u`'s links does not allocate.
+    spare_links: Vec<Link>,
 }
 
 impl Work {
-    /// A working mesh over `pos` and `tris` (already free of degenerate and duplicate faces).
-    pub(super) fn new(pos: Vec<Point3>, tris: Vec<[u32; 3]>) -> Work {
+    /// A working mesh over `pos` and `tris` (already free of degenerate and duplicate faces),
+    /// and the edges of `tris` that have only one face.
+    pub(super) fn new(pos: Vec<Point3>, tris: Vec<[u32; 3]>) -> (Work, Vec<OpenEdge>) {
         let mut vfaces = vec![Vec::new(); pos.len()];
         for (f, t) in tris.iter().enumerate() {
             for &v in t {
@@ -55,32 +90,125 @@ impl Work {
             }
         }
         let live = vfaces.iter().filter(|f| !f.is_empty()).count();
-        let ref_normal = tris
+        let faces = tris
             .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| pos[i as usize]);
-                (b - a).cross(c - a).normalize_or_zero()
+            .map(|&corners| {
+                let [a, b, c] = corners.map(|i| pos[i as usize]);
+                Face {
+                    corners,
+                    ref_normal: (b - a).cross(c - a).normalize_or_zero(),
+                }
             })
             .collect();
-        Work {
-            ref_normal,
+        let numbering = Numbering::identity(pos.len(), tris.len());
+        let mut work = Work {
             quadric: vec![Quadric::default(); pos.len()],
             tri_alive: vec![true; tris.len()],
+            adj: vec![Vec::new(); pos.len()],
+            ends: Vec::new(),
+            boundary: vec![false; pos.len()],
             pos,
-            tris,
+            faces,
             vfaces,
             live,
-            scratch_u: Vec::new(),
-            scratch_v: Vec::new(),
+            numbering,
+            scratch: Vec::new(),
+            spare_links: Vec::new(),
+        };
+        let open = work.build_edges();
+        (work, open)
+    }
+
+    /// Numbers the edges in order of their ends and fills `ends`, `adj` and `boundary`;
+    /// returns the edges with one face.
+    fn build_edges(&mut self) -> Vec<OpenEdge> {
+        let mut sides: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * self.faces.len());
+        for (f, face) in self.faces.iter().enumerate() {
+            let t = face.corners;
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                sides.push((a.min(b), a.max(b), f as u32));
+            }
+        }
+        sides.sort_unstable();
+        let mut open = Vec::new();
+        for run in sides.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+            let (a, b, face) = run[0];
+            let edge = self.ends.len() as u32;
+            self.ends.push([a, b]);
+            self.adj[a as usize].push(Link { nbr: b, edge });
+            self.adj[b as usize].push(Link { nbr: a, edge });
+            if run.len() == 1 {
+                self.boundary[a as usize] = true;
+                self.boundary[b as usize] = true;
+                open.push(OpenEdge { a, b, face });
+            }
+        }
+        for links in &mut self.adj {
+            links.sort_unstable_by_key(|l| l.nbr);
+        }
+        open
+    }
+
+    /// Stores vertices and faces in `numbering`'s order (from input indices, which they must
+    /// still have). Collapse decisions keep depending on input indices only.
+    pub(super) fn renumber(&mut self, numbering: Numbering) {
+        let vw = &numbering.vertex_work;
+        let fw = &numbering.face_work;
+        let by_vertex = |i: usize| vw[i] as usize;
+        self.pos = permuted(std::mem::take(&mut self.pos), by_vertex);
+        self.quadric = permuted(std::mem::take(&mut self.quadric), by_vertex);
+        self.boundary = permuted(std::mem::take(&mut self.boundary), by_vertex);
+        self.vfaces = permuted(std::mem::take(&mut self.vfaces), by_vertex);
+        for faces in &mut self.vfaces {
+            for f in faces.iter_mut() {
+                *f = fw[*f as usize];
+            }
+        }
+        self.adj = permuted(std::mem::take(&mut self.adj), by_vertex);
+        for links in &mut self.adj {
+            for l in links.iter_mut() {
+                l.nbr = vw[l.nbr as usize];
+            }
+            links.sort_unstable_by_key(|l| l.nbr);
+        }
+        for ends in &mut self.ends {
+            let [a, b] = ends.map(|v| vw[v as usize]);
+            *ends = [a.min(b), a.max(b)];
+        }
+        let by_face = |i: usize| fw[i] as usize;
+        self.faces = permuted(std::mem::take(&mut self.faces), by_face);
+        for face in &mut self.faces {
+            face.corners = face.corners.map(|v| vw[v as usize]);
+        }
+        self.tri_alive = permuted(std::mem::take(&mut self.tri_alive), by_face);
+        self.numbering = numbering;
+    }
+
+    /// The ends of edge `edge`, the one with the lower input index first: it survives the
+    /// collapse and comes first in the placement, as it did before the renumbering.
+    pub(super) fn edge_ends(&self, edge: u32) -> (u32, u32) {
+        let [a, b] = self.ends[edge as usize];
+        let input = &self.numbering.vertex_input;
+        if input[a as usize] < input[b as usize] {
+            (a, b)
+        } else {
+            (b, a)
         }
     }
 
-    /// Sorted distinct neighbours of `v` into `out`; returns whether `v` is on a boundary (an
-    /// incident edge with only one face).
+    /// Sorted distinct neighbours of `v` into `out`, found from its faces; returns whether `v`
+    /// is on a boundary (an incident edge with only one face).
     fn neighbours(&self, v: u32, out: &mut Vec<u32>) -> bool {
         out.clear();
         for &f in &self.vfaces[v as usize] {
-            out.extend(self.tris[f as usize].iter().copied().filter(|&w| w != v));
+            out.extend(
+                self.faces[f as usize]
+                    .corners
+                    .iter()
+                    .copied()
+                    .filter(|&w| w != v),
+            );
         }
         out.sort_unstable();
         let mut boundary = false;
@@ -94,21 +222,14 @@ impl Work {
         boundary
     }
 
-    /// Distinct neighbours of `v`, sorted.
-    pub(super) fn neighbour_list(&self, v: u32) -> Vec<u32> {
-        let mut out = Vec::new();
-        self.neighbours(v, &mut out);
-        out
-    }
-
     /// Whether collapsing edge `u`–`v` keeps the surface a manifold of the same topology: the
     /// link condition (common neighbours are exactly the opposite vertices of the edge's faces,
     /// with the boundary counted as a virtual vertex), no orphaned vertex, no duplicate face.
-    fn topology_allows(&mut self, u: u32, v: u32) -> bool {
+    fn topology_allows(&self, u: u32, v: u32) -> bool {
         let mut opposite = [u32::MAX; 2];
         let mut k = 0;
         for &f in &self.vfaces[u as usize] {
-            let t = self.tris[f as usize];
+            let t = self.faces[f as usize].corners;
             if t.contains(&v) {
                 if k == 2 {
                     return false; // non-manifold edge
@@ -128,22 +249,15 @@ impl Work {
         {
             return false;
         }
-        let (mut nu, mut nv) = (
-            std::mem::take(&mut self.scratch_u),
-            std::mem::take(&mut self.scratch_v),
-        );
-        let bu = self.neighbours(u, &mut nu);
-        let bv = self.neighbours(v, &mut nv);
-        let common = count_common(&nu, &nv);
-        self.scratch_u = nu;
-        self.scratch_v = nv;
+        let common = count_common(&self.adj[u as usize], &self.adj[v as usize]);
+        let (bu, bv) = (self.boundary[u as usize], self.boundary[v as usize]);
         if common != k || (k == 2 && bu && bv) {
             return false;
         }
         // Tetrahedron-like case: a face v-x-y with x, y the opposite vertices would duplicate u-x-y.
         !(k == 2
             && self.vfaces[v as usize].iter().any(|&f| {
-                let t = self.tris[f as usize];
+                let t = self.faces[f as usize].corners;
                 !t.contains(&u) && t.contains(&opposite[0]) && t.contains(&opposite[1])
             }))
     }
@@ -155,7 +269,10 @@ impl Work {
         let mut min_new = f64::INFINITY;
         for &w in &[u, v] {
             for &f in &self.vfaces[w as usize] {
-                let t = self.tris[f as usize];
+                let Face {
+                    corners: t,
+                    ref_normal,
+                } = self.faces[f as usize];
                 if t.contains(&u) && t.contains(&v) {
                     continue;
                 }
@@ -166,7 +283,7 @@ impl Work {
                 let len = n_old.length() * n_new.length();
                 if n_new == Vec3::ZERO
                     || n_old.dot(n_new) < limits.min_normal_cos * len
-                    || n_new.dot(self.ref_normal[f as usize]) < 0.0
+                    || n_new.dot(ref_normal) < 0.0
                 {
                     return false;
                 }
@@ -178,20 +295,25 @@ impl Work {
     }
 
     /// Whether edge `u`–`v` may collapse to `p`.
-    pub(super) fn allows(&mut self, u: u32, v: u32, p: Point3, limits: &Limits) -> bool {
+    pub(super) fn allows(&self, u: u32, v: u32, p: Point3, limits: &Limits) -> bool {
         self.topology_allows(u, v) && self.geometry_allows(u, v, p, limits)
     }
 
-    /// Collapses `v` into `u`, which moves to `p`. The caller has checked [`Work::allows`].
-    pub(super) fn collapse(&mut self, u: u32, v: u32, p: Point3) {
+    /// Collapses `v` into `u`, which moves to `p`, and pushes the ids of the edges this
+    /// removes onto `removed`. The caller has checked [`Work::allows`].
+    pub(super) fn collapse(&mut self, u: u32, v: u32, p: Point3, removed: &mut Vec<u32>) {
+        let mut opposite = [u32::MAX; 2];
         let faces_v = std::mem::take(&mut self.vfaces[v as usize]);
         for f in faces_v {
-            let t = &mut self.tris[f as usize];
+            let t = &mut self.faces[f as usize].corners;
             if t.contains(&u) {
                 self.tri_alive[f as usize] = false;
                 let t = *t;
                 for w in t.into_iter().filter(|&w| w != v) {
                     self.vfaces[w as usize].retain(|&g| g != f);
+                    if w != u {
+                        opposite[usize::from(opposite[0] != u32::MAX)] = w;
+                    }
                 }
             } else {
                 for w in t.iter_mut().filter(|w| **w == v) {
@@ -204,14 +326,124 @@ impl Work {
         self.quadric[u as usize] += qv;
         self.pos[u as usize] = p;
         self.live -= 1;
+        self.merge_links(u, v, removed);
+        // Only the opposite vertices lose faces around an edge, so only their boundary status
+        // (besides `u`'s) can change, and only if they had an edge with one face.
+        let on_boundary = opposite.map(|x| x != u32::MAX && self.boundary[x as usize]);
+        for (x, _) in opposite.into_iter().zip(on_boundary).filter(|(_, b)| *b) {
+            let mut scratch = std::mem::take(&mut self.scratch);
+            self.boundary[x as usize] = self.neighbours(x, &mut scratch);
+            self.scratch = scratch;
+        }
+    }
+
+    /// Rebuilds `u`'s links after `v` merged into it: an edge to a neighbour keeps `u`'s id
+    /// if `u` had one, else takes over `v`'s; every other edge of `u` and `v` is removed.
+    ///
+    /// Away from boundaries every edge of the two ends but `u`–`v` survives (an edge `x`–`u`
+    /// only vanishes with `x`–`v` when both had the removed face `u`–`v`–`x` alone, which makes
+    /// all three boundary vertices), so the new neighbours are the union of the old ones and
+    /// the faces need not be walked.
+    fn merge_links(&mut self, u: u32, v: u32, removed: &mut Vec<u32>) {
+        let interior = !self.boundary[u as usize] && !self.boundary[v as usize];
+        let old_u = std::mem::take(&mut self.adj[u as usize]);
+        let old_v = std::mem::take(&mut self.adj[v as usize]);
+        let mut nbrs = std::mem::take(&mut self.scratch);
+        if interior {
+            sorted_union(&old_u, &old_v, &mut nbrs);
+            nbrs.retain(|&w| w != u && w != v);
+        } else {
+            self.boundary[u as usize] = self.neighbours(u, &mut nbrs);
+        }
+        let mut links = std::mem::take(&mut self.spare_links);
+        links.clear();
+        let (mut i, mut j) = (0, 0);
+        for &w in nbrs.iter().chain(std::iter::once(&u32::MAX)) {
+            while i < old_u.len() && old_u[i].nbr < w {
+                self.remove_link(old_u[i], u, v, removed);
+                i += 1;
+            }
+            while j < old_v.len() && old_v[j].nbr < w {
+                self.remove_link(old_v[j], v, u, removed);
+                j += 1;
+            }
+            let from_u = old_u.get(i).filter(|l| l.nbr == w).copied();
+            let from_v = old_v.get(j).filter(|l| l.nbr == w).copied();
+            i += usize::from(from_u.is_some());
+            j += usize::from(from_v.is_some());
+            match (from_u, from_v) {
+                (Some(keep), Some(drop)) => {
+                    self.remove_link(drop, v, u, removed);
+                    links.push(keep);
+                }
+                (Some(keep), None) => links.push(keep),
+                (None, Some(moved)) => {
+                    self.relink(moved.edge, w, u);
+                    links.push(moved);
+                }
+                (None, None) => {}
+            }
+        }
+        self.adj[u as usize] = links;
+        self.spare_links = old_u;
+        self.scratch = nbrs;
+    }
+
+    /// Removes edge `link` of vertex `from` (whose links are being rebuilt): from the other
+    /// end's links, unless that is `partner` (the edge `u`–`v`, whose links both go).
+    fn remove_link(&mut self, link: Link, from: u32, partner: u32, removed: &mut Vec<u32>) {
+        if link.nbr == partner {
+            // Edge u–v: seen from both ends, recorded once.
+            if from < partner {
+                removed.push(link.edge);
+            }
+            return;
+        }
+        self.adj[link.nbr as usize].retain(|l| l.edge != link.edge);
+        removed.push(link.edge);
+    }
+
+    /// Makes edge `edge` of `w` lead to `new` instead, in `w`'s sorted links and in `ends`.
+    fn relink(&mut self, edge: u32, w: u32, new: u32) {
+        self.ends[edge as usize] = [w.min(new), w.max(new)];
+        let links = &mut self.adj[w as usize];
+        for l in links.iter_mut().filter(|l| l.edge == edge) {
+            l.nbr = new;
+        }
+        links.sort_unstable_by_key(|l| l.nbr);
     }
 }
 
-/// Number of values present in both sorted, deduplicated slices.
-fn count_common(a: &[u32], b: &[u32]) -> usize {
+/// `items` moved to the indices `to` gives for their current ones.
+fn permuted<T: Default>(items: Vec<T>, to: impl Fn(usize) -> usize) -> Vec<T> {
+    let mut out: Vec<T> = std::iter::repeat_with(T::default)
+        .take(items.len())
+        .collect();
+    for (i, item) in items.into_iter().enumerate() {
+        out[to(i)] = item;
+    }
+    out
+}
+
+/// The neighbours in either of two sorted link lists, sorted, into `out`.
+fn sorted_union(a: &[Link], b: &[Link], out: &mut Vec<u32>) {
+    out.clear();
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        let x = a.get(i).map_or(u32::MAX, |l| l.nbr);
+        let y = b.get(j).map_or(u32::MAX, |l| l.nbr);
+        let w = x.min(y);
+        i += usize::from(x == w);
+        j += usize::from(y == w);
+        out.push(w);
+    }
+}
+
+/// Number of neighbours present in both sorted link lists.
+fn count_common(a: &[Link], b: &[Link]) -> usize {
     let (mut i, mut j, mut n) = (0, 0, 0);
     while i < a.len() && j < b.len() {
-        match a[i].cmp(&b[j]) {
+        match a[i].nbr.cmp(&b[j].nbr) {
             std::cmp::Ordering::Less => i += 1,
             std::cmp::Ordering::Greater => j += 1,
             std::cmp::Ordering::Equal => {
@@ -243,7 +475,7 @@ mod tests {
                 tris.push([a, a + n + 1, a + n]);
             }
         }
-        Work::new(pos, tris)
+        Work::new(pos, tris).0
     }
 
     const LOOSE: Limits = Limits {
@@ -255,9 +487,9 @@ mod tests {
     fn interior_edge_joining_two_boundary_vertices_is_refused() {
         // 3×3 vertices: edge 1–4 joins boundary vertex 1 to centre 4 (allowed); in a 2×2 grid
         // the diagonal 0–3 joins two boundary vertices (refused: it would pinch the disc).
-        let mut w = grid(3);
+        let w = grid(3);
         assert!(w.allows(4, 1, w.pos[4], &LOOSE));
-        let mut w = grid(2);
+        let w = grid(2);
         assert!(!w.allows(0, 3, w.pos[0], &LOOSE));
         assert!(w.allows(0, 1, w.pos[0], &LOOSE));
     }
@@ -266,21 +498,84 @@ mod tests {
     fn collapse_moves_faces_and_counts() {
         let mut w = grid(3);
         let before = w.tri_alive.iter().filter(|&&a| a).count();
-        w.collapse(4, 5, Point3::new(1.5, 1.0, 0.0));
+        let mut removed = Vec::new();
+        w.collapse(4, 5, Point3::new(1.5, 1.0, 0.0), &mut removed);
+        // Edge 4–5 and one of each pair 4–x, 5–x of the two faces' opposite vertices x.
+        assert_eq!(removed.len(), 3);
         assert_eq!(w.live, 8);
         assert_eq!(w.tri_alive.iter().filter(|&&a| a).count(), before - 2);
         assert!(w.vfaces[5].is_empty());
         assert!(w
-            .tris
+            .faces
             .iter()
+            .map(|f| f.corners)
             .zip(&w.tri_alive)
             .all(|(t, &a)| !a || !t.contains(&5)));
     }
 
     #[test]
     fn flipping_move_is_refused() {
-        let mut w = grid(3);
+        let w = grid(3);
         // Moving the merged vertex beyond vertex 7 (at (1, 2)) flips face 4-8-7.
         assert!(!w.allows(4, 1, Point3::new(1.0, 2.5, 0.0), &LOOSE));
+    }
+
+    /// The links and boundary flags recomputed from the faces, as `collapse` should keep them.
+    fn assert_links_match_faces(w: &Work) {
+        let mut nbrs = Vec::new();
+        for v in 0..w.pos.len() as u32 {
+            let boundary = w.neighbours(v, &mut nbrs);
+            let linked: Vec<u32> = w.adj[v as usize].iter().map(|l| l.nbr).collect();
+            assert_eq!(linked, nbrs, "neighbours of {v}");
+            if !nbrs.is_empty() {
+                assert_eq!(w.boundary[v as usize], boundary, "boundary flag of {v}");
+            }
+            for l in &w.adj[v as usize] {
+                assert_eq!(w.ends[l.edge as usize], [v.min(l.nbr), v.max(l.nbr)]);
+                assert!(w.adj[l.nbr as usize].contains(&Link {
+                    nbr: v,
+                    edge: l.edge
+                }));
+            }
+        }
+    }
+
+    #[test]
+    fn links_follow_collapses() {
+        let mut w = grid(6);
+        assert_links_match_faces(&w);
+        let mut removed = Vec::new();
+        let mut gone = std::collections::BTreeSet::new();
+        // Interior, boundary and corner collapses, and more where earlier ones left edges.
+        let mut done = 0;
+        for (u, v) in [
+            (14, 15),
+            (14, 20),
+            (0, 1),
+            (2, 8),
+            (22, 28),
+            (29, 35),
+            (14, 21),
+            (7, 14),
+            (0, 7),
+            (9, 16),
+            (16, 22),
+        ] {
+            if !w.allows(u, v, w.pos[u as usize], &LOOSE) {
+                continue;
+            }
+            done += 1;
+            removed.clear();
+            w.collapse(u, v, w.pos[u as usize], &mut removed);
+            assert_links_match_faces(&w);
+            for e in &removed {
+                assert!(gone.insert(*e), "edge {e} removed twice");
+            }
+        }
+        assert!(done >= 8, "only {done} collapses");
+        let linked: std::collections::BTreeSet<u32> =
+            w.adj.iter().flatten().map(|l| l.edge).collect();
+        assert!(linked.is_disjoint(&gone));
+        assert_eq!(linked.len() + gone.len(), w.ends.len());
     }
 }

@@ -37,6 +37,7 @@
 mod collapse;
 mod deviation;
 mod error;
+mod locality;
 mod quadric;
 mod queue;
 
@@ -45,7 +46,8 @@ pub use error::SimplifyError;
 
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
-use collapse::{Limits, Work};
+use collapse::{Limits, OpenEdge, Work};
+use locality::Numbering;
 use quadric::Quadric;
 use queue::{Candidate, Queue};
 
@@ -184,14 +186,16 @@ pub fn simplify_with(
             min: MIN_TARGET,
         });
     }
-    let mut work = Work::new(mesh.positions().to_vec(), clean_triangles(mesh));
+    let (mut work, open_edges) = Work::new(mesh.positions().to_vec(), clean_triangles(mesh));
     if target > work.live {
         return Err(SimplifyError::TargetTooLarge {
             target,
             available: work.live,
         });
     }
-    init_quadrics(&mut work, options.boundary_weight);
+    init_quadrics(&mut work, &open_edges, options.boundary_weight);
+    let corners: Vec<[u32; 3]> = work.faces.iter().map(|f| f.corners).collect();
+    work.renumber(Numbering::spatial(&work.pos, &corners));
     reduce(&mut work, target, options)?;
     output(&work)
 }
@@ -225,40 +229,30 @@ fn clean_triangles(mesh: &PolyMesh) -> Vec<[u32; 3]> {
         .collect()
 }
 
-/// Area-weighted face-plane quadrics at every vertex, plus boundary penalty planes.
-fn init_quadrics(work: &mut Work, boundary_weight: f64) {
-    let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * work.tris.len());
-    for (f, t) in work.tris.iter().enumerate() {
+/// Area-weighted face-plane quadrics at every vertex, plus penalty planes along the edges
+/// with one face.
+fn init_quadrics(work: &mut Work, open_edges: &[OpenEdge], boundary_weight: f64) {
+    for t in work.faces.iter().map(|f| f.corners) {
         let p = t.map(|i| work.pos[i as usize]);
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let q = Quadric::plane(n.normalize_or_zero(), p[0], 0.5 * n.length());
-        for k in 0..3 {
-            work.quadric[t[k] as usize] += q;
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            edges.push((a.min(b), a.max(b), f as u32));
+        for v in t {
+            work.quadric[v as usize] += q;
         }
     }
     if boundary_weight == 0.0 {
         return;
     }
-    edges.sort_unstable();
-    let mut i = 0;
-    while i < edges.len() {
-        let run = edges[i..]
-            .iter()
-            .take_while(|e| (e.0, e.1) == (edges[i].0, edges[i].1))
-            .count();
-        if run == 1 {
-            let (a, b, f) = edges[i];
-            let t = work.tris[f as usize].map(|v| work.pos[v as usize]);
-            let face_normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-            let (pa, pb) = (work.pos[a as usize], work.pos[b as usize]);
-            let normal = (pb - pa).cross(face_normal).normalize_or_zero();
-            let q = Quadric::plane(normal, pa, boundary_weight * pa.distance_squared(pb));
-            work.quadric[a as usize] += q;
-            work.quadric[b as usize] += q;
-        }
-        i += run;
+    for &OpenEdge { a, b, face } in open_edges {
+        let t = work.faces[face as usize]
+            .corners
+            .map(|v| work.pos[v as usize]);
+        let face_normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        let (pa, pb) = (work.pos[a as usize], work.pos[b as usize]);
+        let normal = (pb - pa).cross(face_normal).normalize_or_zero();
+        let q = Quadric::plane(normal, pa, boundary_weight * pa.distance_squared(pb));
+        work.quadric[a as usize] += q;
+        work.quadric[b as usize] += q;
     }
 }
 
@@ -286,41 +280,40 @@ fn placement(work: &Work, u: u32, v: u32) -> (Point3, f64) {
     (target, q.eval(target))
 }
 
-/// Edge `u`–`v` (`u < v`) as a queued candidate.
-fn candidate(work: &Work, u: u32, v: u32) -> Candidate {
+/// Edge `edge` as a queue entry (ordered by input indices); its collapse position goes to
+/// `targets`.
+fn candidate(work: &Work, edge: u32, targets: &mut [Point3]) -> Candidate {
+    let (u, v) = work.edge_ends(edge);
+    let (target, cost) = placement(work, u, v);
+    targets[edge as usize] = target;
+    let input = &work.numbering.vertex_input;
     Candidate {
-        cost: placement(work, u, v).1,
-        u,
-        v,
+        cost,
+        u: input[u as usize],
+        v: input[v as usize],
+        edge,
     }
 }
 
-/// Every edge of the current mesh as a candidate.
-fn all_candidates(work: &Work) -> Queue {
-    let mut heap = Vec::new();
-    for (f, t) in work.tris.iter().enumerate() {
-        if !work.tri_alive[f] {
-            continue;
-        }
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            heap.push((a.min(b), a.max(b)));
+/// Every edge of the current mesh, queued.
+fn all_candidates(work: &Work, targets: &mut [Point3]) -> Queue {
+    let mut items = Vec::new();
+    for (v, links) in work.adj.iter().enumerate() {
+        for l in links.iter().filter(|l| l.nbr > v as u32) {
+            items.push(candidate(work, l.edge, targets));
         }
     }
-    heap.sort_unstable();
-    heap.dedup();
-    Queue::from_vec(
-        heap.into_iter()
-            .map(|(u, v)| candidate(work, u, v))
-            .collect(),
-    )
+    Queue::new(work.ends.len(), items)
 }
 
 /// Collapses edges until `target` vertices are left.
 fn reduce(work: &mut Work, target: usize, options: &SimplifyOptions) -> Result<(), SimplifyError> {
     let mut limits = options.limits();
     let mut relaxed = false;
-    let mut heap = all_candidates(work);
+    // Where each edge would collapse to, for its queued cost.
+    let mut targets = vec![Point3::ZERO; work.ends.len()];
+    let mut heap = all_candidates(work, &mut targets);
+    let mut removed = Vec::new();
     let mut progress_since_rebuild = false;
     while work.live > target {
         let Some(c) = heap.pop() else {
@@ -338,44 +331,45 @@ fn reduce(work: &mut Work, target: usize, options: &SimplifyOptions) -> Result<(
                 };
             }
             // Collapses refused earlier may have become valid as their neighbourhood changed.
-            heap = all_candidates(work);
+            heap = all_candidates(work, &mut targets);
             progress_since_rebuild = false;
             continue;
         };
-        if work.vfaces[c.u as usize].is_empty() || work.vfaces[c.v as usize].is_empty() {
+        // A refused edge stays out of the queue until a collapse at one of its ends re-costs it.
+        let p = targets[c.edge as usize];
+        let (u, v) = work.edge_ends(c.edge);
+        if !work.allows(u, v, p, &limits) {
             continue;
         }
-        // A candidate is stale once an end has moved: its cost then differs from the current
-        // one, which was queued anew when the end moved.
-        let (target, cost) = placement(work, c.u, c.v);
-        if cost.to_bits() != c.cost.to_bits() || !work.allows(c.u, c.v, target, &limits) {
-            continue;
-        }
-        work.collapse(c.u, c.v, target);
+        removed.clear();
+        work.collapse(u, v, p, &mut removed);
         progress_since_rebuild = true;
-        for w in work.neighbour_list(c.u) {
-            heap.push(candidate(work, c.u.min(w), c.u.max(w)));
+        for &e in &removed {
+            heap.remove(e);
+        }
+        for l in &work.adj[u as usize] {
+            heap.set(candidate(work, l.edge, &mut targets));
         }
     }
     Ok(())
 }
 
-/// The surviving vertices (in input order) and faces as a [`PolyMesh`].
+/// The surviving vertices and faces, in input order, as a [`PolyMesh`].
 fn output(work: &Work) -> Result<PolyMesh, SimplifyError> {
+    let numbering = &work.numbering;
     let mut remap = vec![u32::MAX; work.pos.len()];
     let mut positions = Vec::with_capacity(work.live);
-    for (v, faces) in work.vfaces.iter().enumerate() {
-        if !faces.is_empty() {
-            remap[v] = positions.len() as u32;
-            positions.push(work.pos[v]);
+    for &v in &numbering.vertex_work {
+        if !work.vfaces[v as usize].is_empty() {
+            remap[v as usize] = positions.len() as u32;
+            positions.push(work.pos[v as usize]);
         }
     }
-    let faces: Vec<[u32; 3]> = work
-        .tris
+    let faces: Vec<[u32; 3]> = numbering
+        .face_work
         .iter()
-        .zip(&work.tri_alive)
-        .filter(|(_, &alive)| alive)
-        .map(|(t, _)| t.map(|v| remap[v as usize]))
+        .filter(|&&f| work.tri_alive[f as usize])
+        .map(|&f| work.faces[f as usize].corners.map(|v| remap[v as usize]))
         .collect();
     Ok(PolyMesh::try_new(positions, faces)?)
 }
