@@ -4,6 +4,7 @@
 //! Incidence lists (each vertex knows its faces) rather than half-edges, so that inputs with
 //! non-manifold edges or vertices are still represented; such places are simply never collapsed.
 
+use super::incidence::{Incidence, InputEdge};
 use super::locality::Numbering;
 use super::quadric::Quadric;
 use crate::geom::{Point3, Vec3};
@@ -34,13 +35,6 @@ fn quality(a: Point3, b: Point3, c: Point3) -> f64 {
 pub(super) struct Link {
     pub(super) nbr: u32,
     pub(super) edge: u32,
-}
-
-/// An edge with a single face, `a < b`: where a boundary penalty plane goes.
-pub(super) struct OpenEdge {
-    pub(super) a: u32,
-    pub(super) b: u32,
-    pub(super) face: u32,
 }
 
 /// A triangle of the working mesh, with what the fold-over test needs of it in one place (the
@@ -80,109 +74,73 @@ pub(super) struct Work {
 }
 
 impl Work {
-    /// A working mesh over `pos` and `tris` (already free of degenerate and duplicate faces),
-    /// and the edges of `tris` that have only one face.
-    pub(super) fn new(pos: Vec<Point3>, tris: Vec<[u32; 3]>) -> (Work, Vec<OpenEdge>) {
-        let mut vfaces = vec![Vec::new(); pos.len()];
-        for (f, t) in tris.iter().enumerate() {
-            for &v in t {
+    /// The working mesh of the input's `pos` and `tris` (free of degenerate and duplicate
+    /// faces), with their incidence, edges and vertex quadrics, stored in `numbering`'s order.
+    pub(super) fn new(
+        pos: &[Point3],
+        tris: &[[u32; 3]],
+        incidence: &Incidence,
+        edges: &[InputEdge],
+        quadric: &[Quadric],
+        numbering: Numbering,
+    ) -> Work {
+        let (input, vw) = (&numbering.vertex_input, &numbering.vertex_work);
+        let mut faces = vec![Face::default(); tris.len()];
+        for (t, &f) in tris.iter().zip(&numbering.face_work) {
+            let [a, b, c] = t.map(|i| pos[i as usize]);
+            faces[f as usize] = Face {
+                corners: t.map(|v| vw[v as usize]),
+                ref_normal: (b - a).cross(c - a).normalize_or_zero(),
+            };
+        }
+        // Room for the faces and links a vertex gains in its first collapses.
+        let valence = |w: u32| incidence.faces_of(input[w as usize]).len();
+        let mut vfaces: Vec<Vec<u32>> = (0..pos.len() as u32)
+            .map(|w| Vec::with_capacity(valence(w) + 4))
+            .collect();
+        for (f, face) in faces.iter().enumerate() {
+            for &v in &face.corners {
                 vfaces[v as usize].push(f as u32);
             }
         }
-        let live = vfaces.iter().filter(|f| !f.is_empty()).count();
-        let faces = tris
-            .iter()
-            .map(|&corners| {
-                let [a, b, c] = corners.map(|i| pos[i as usize]);
-                Face {
-                    corners,
-                    ref_normal: (b - a).cross(c - a).normalize_or_zero(),
-                }
-            })
+        let mut adj: Vec<Vec<Link>> = (0..pos.len() as u32)
+            .map(|w| Vec::with_capacity(valence(w) + 4))
             .collect();
-        let numbering = Numbering::identity(pos.len(), tris.len());
-        let mut work = Work {
-            quadric: vec![Quadric::default(); pos.len()],
-            tri_alive: vec![true; tris.len()],
-            adj: vec![Vec::new(); pos.len()],
-            ends: Vec::new(),
-            boundary: vec![false; pos.len()],
-            pos,
+        let mut boundary = vec![false; pos.len()];
+        let mut ends = Vec::with_capacity(edges.len());
+        for (e, edge) in edges.iter().enumerate() {
+            let (a, b) = (vw[edge.a as usize], vw[edge.b as usize]);
+            ends.push([a.min(b), a.max(b)]);
+            adj[a as usize].push(Link {
+                nbr: b,
+                edge: e as u32,
+            });
+            adj[b as usize].push(Link {
+                nbr: a,
+                edge: e as u32,
+            });
+            if edge.faces == 1 {
+                boundary[a as usize] = true;
+                boundary[b as usize] = true;
+            }
+        }
+        for links in &mut adj {
+            links.sort_unstable_by_key(|l| l.nbr);
+        }
+        Work {
+            pos: input.iter().map(|&i| pos[i as usize]).collect(),
+            quadric: input.iter().map(|&i| quadric[i as usize]).collect(),
+            tri_alive: vec![true; faces.len()],
             faces,
             vfaces,
-            live,
+            adj,
+            ends,
+            boundary,
+            live: incidence.used_vertices(),
             numbering,
             scratch: Vec::new(),
             spare_links: Vec::new(),
-        };
-        let open = work.build_edges();
-        (work, open)
-    }
-
-    /// Numbers the edges in order of their ends and fills `ends`, `adj` and `boundary`;
-    /// returns the edges with one face.
-    fn build_edges(&mut self) -> Vec<OpenEdge> {
-        let mut sides: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * self.faces.len());
-        for (f, face) in self.faces.iter().enumerate() {
-            let t = face.corners;
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                sides.push((a.min(b), a.max(b), f as u32));
-            }
         }
-        sides.sort_unstable();
-        let mut open = Vec::new();
-        for run in sides.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-            let (a, b, face) = run[0];
-            let edge = self.ends.len() as u32;
-            self.ends.push([a, b]);
-            self.adj[a as usize].push(Link { nbr: b, edge });
-            self.adj[b as usize].push(Link { nbr: a, edge });
-            if run.len() == 1 {
-                self.boundary[a as usize] = true;
-                self.boundary[b as usize] = true;
-                open.push(OpenEdge { a, b, face });
-            }
-        }
-        for links in &mut self.adj {
-            links.sort_unstable_by_key(|l| l.nbr);
-        }
-        open
-    }
-
-    /// Stores vertices and faces in `numbering`'s order (from input indices, which they must
-    /// still have). Collapse decisions keep depending on input indices only.
-    pub(super) fn renumber(&mut self, numbering: Numbering) {
-        let vw = &numbering.vertex_work;
-        let fw = &numbering.face_work;
-        let by_vertex = |i: usize| vw[i] as usize;
-        self.pos = permuted(std::mem::take(&mut self.pos), by_vertex);
-        self.quadric = permuted(std::mem::take(&mut self.quadric), by_vertex);
-        self.boundary = permuted(std::mem::take(&mut self.boundary), by_vertex);
-        self.vfaces = permuted(std::mem::take(&mut self.vfaces), by_vertex);
-        for faces in &mut self.vfaces {
-            for f in faces.iter_mut() {
-                *f = fw[*f as usize];
-            }
-        }
-        self.adj = permuted(std::mem::take(&mut self.adj), by_vertex);
-        for links in &mut self.adj {
-            for l in links.iter_mut() {
-                l.nbr = vw[l.nbr as usize];
-            }
-            links.sort_unstable_by_key(|l| l.nbr);
-        }
-        for ends in &mut self.ends {
-            let [a, b] = ends.map(|v| vw[v as usize]);
-            *ends = [a.min(b), a.max(b)];
-        }
-        let by_face = |i: usize| fw[i] as usize;
-        self.faces = permuted(std::mem::take(&mut self.faces), by_face);
-        for face in &mut self.faces {
-            face.corners = face.corners.map(|v| vw[v as usize]);
-        }
-        self.tri_alive = permuted(std::mem::take(&mut self.tri_alive), by_face);
-        self.numbering = numbering;
     }
 
     /// The ends of edge `edge`, the one with the lower input index first: it survives the
@@ -265,33 +223,44 @@ impl Work {
     /// Whether moving `u` and `v` to `p` keeps every surviving face within the normal-rotation
     /// limit and avoids creating needles.
     fn geometry_allows(&self, u: u32, v: u32, p: Point3, limits: &Limits) -> bool {
-        let mut min_old = f64::INFINITY;
         let mut min_new = f64::INFINITY;
-        for &w in &[u, v] {
-            for &f in &self.vfaces[w as usize] {
-                let Face {
-                    corners: t,
-                    ref_normal,
-                } = self.faces[f as usize];
-                if t.contains(&u) && t.contains(&v) {
-                    continue;
-                }
-                let old = t.map(|i| self.pos[i as usize]);
-                let new = t.map(|i| if i == w { p } else { self.pos[i as usize] });
-                let n_old = (old[1] - old[0]).cross(old[2] - old[0]);
-                let n_new = (new[1] - new[0]).cross(new[2] - new[0]);
-                let len = n_old.length() * n_new.length();
-                if n_new == Vec3::ZERO
-                    || n_old.dot(n_new) < limits.min_normal_cos * len
-                    || n_new.dot(ref_normal) < 0.0
-                {
-                    return false;
-                }
-                min_old = min_old.min(quality(old[0], old[1], old[2]));
-                min_new = min_new.min(quality(new[0], new[1], new[2]));
+        for (w, face) in self.moved_faces(u, v) {
+            let old = face.corners.map(|i| self.pos[i as usize]);
+            let new = face
+                .corners
+                .map(|i| if i == w { p } else { self.pos[i as usize] });
+            let n_old = (old[1] - old[0]).cross(old[2] - old[0]);
+            let n_new = (new[1] - new[0]).cross(new[2] - new[0]);
+            let len = n_old.length() * n_new.length();
+            if n_new == Vec3::ZERO
+                || n_old.dot(n_new) < limits.min_normal_cos * len
+                || n_new.dot(face.ref_normal) < 0.0
+            {
+                return false;
             }
+            min_new = min_new.min(quality(new[0], new[1], new[2]));
         }
-        min_new >= limits.min_quality.min(min_old)
+        // The old triangles' quality only matters when a new one falls below the limit.
+        min_new >= limits.min_quality
+            || min_new
+                >= self
+                    .moved_faces(u, v)
+                    .map(|(_, f)| {
+                        let [a, b, c] = f.corners.map(|i| self.pos[i as usize]);
+                        quality(a, b, c)
+                    })
+                    .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The faces around `u` and `v` that survive their collapse, each with the end it has.
+    fn moved_faces(&self, u: u32, v: u32) -> impl Iterator<Item = (u32, Face)> + '_ {
+        [u, v].into_iter().flat_map(move |w| {
+            self.vfaces[w as usize]
+                .iter()
+                .map(|&f| self.faces[f as usize])
+                .filter(move |f| !(f.corners.contains(&u) && f.corners.contains(&v)))
+                .map(move |f| (w, f))
+        })
     }
 
     /// Whether edge `u`–`v` may collapse to `p`.
@@ -414,17 +383,6 @@ impl Work {
     }
 }
 
-/// `items` moved to the indices `to` gives for their current ones.
-fn permuted<T: Default>(items: Vec<T>, to: impl Fn(usize) -> usize) -> Vec<T> {
-    let mut out: Vec<T> = std::iter::repeat_with(T::default)
-        .take(items.len())
-        .collect();
-    for (i, item) in items.into_iter().enumerate() {
-        out[to(i)] = item;
-    }
-    out
-}
-
 /// The neighbours in either of two sorted link lists, sorted, into `out`.
 fn sorted_union(a: &[Link], b: &[Link], out: &mut Vec<u32>) {
     out.clear();
@@ -475,7 +433,11 @@ mod tests {
                 tris.push([a, a + n + 1, a + n]);
             }
         }
-        Work::new(pos, tris).0
+        let incidence = Incidence::new(pos.len(), &tris);
+        let edges = incidence.edges(&tris);
+        let quadric = vec![Quadric::default(); pos.len()];
+        let numbering = Numbering::identity(pos.len(), tris.len());
+        Work::new(&pos, &tris, &incidence, &edges, &quadric, numbering)
     }
 
     const LOOSE: Limits = Limits {

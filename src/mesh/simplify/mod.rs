@@ -37,6 +37,7 @@
 mod collapse;
 mod deviation;
 mod error;
+mod incidence;
 mod locality;
 mod quadric;
 mod queue;
@@ -46,7 +47,8 @@ pub use error::SimplifyError;
 
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
-use collapse::{Limits, OpenEdge, Work};
+use collapse::{Limits, Work};
+use incidence::{Incidence, InputEdge};
 use locality::Numbering;
 use quadric::Quadric;
 use queue::{Candidate, Queue};
@@ -186,16 +188,17 @@ pub fn simplify_with(
             min: MIN_TARGET,
         });
     }
-    let (mut work, open_edges) = Work::new(mesh.positions().to_vec(), clean_triangles(mesh));
-    if target > work.live {
-        return Err(SimplifyError::TargetTooLarge {
-            target,
-            available: work.live,
-        });
+    let pos = mesh.positions();
+    let tris = clean_triangles(mesh);
+    let incidence = Incidence::new(pos.len(), &tris);
+    let available = incidence.used_vertices();
+    if target > available {
+        return Err(SimplifyError::TargetTooLarge { target, available });
     }
-    init_quadrics(&mut work, &open_edges, options.boundary_weight);
-    let corners: Vec<[u32; 3]> = work.faces.iter().map(|f| f.corners).collect();
-    work.renumber(Numbering::spatial(&work.pos, &corners));
+    let edges = incidence.edges(&tris);
+    let quadric = quadrics(pos, &tris, &edges, options.boundary_weight);
+    let numbering = Numbering::spatial(pos, &tris);
+    let mut work = Work::new(pos, &tris, &incidence, &edges, &quadric, numbering);
     reduce(&mut work, target, options)?;
     output(&work)
 }
@@ -230,30 +233,36 @@ fn clean_triangles(mesh: &PolyMesh) -> Vec<[u32; 3]> {
 }
 
 /// Area-weighted face-plane quadrics at every vertex, plus penalty planes along the edges
-/// with one face.
-fn init_quadrics(work: &mut Work, open_edges: &[OpenEdge], boundary_weight: f64) {
-    for t in work.faces.iter().map(|f| f.corners) {
-        let p = t.map(|i| work.pos[i as usize]);
+/// with one face (in input order: the sums, and so the result, do not depend on the working
+/// numbering).
+fn quadrics(
+    pos: &[Point3],
+    tris: &[[u32; 3]],
+    edges: &[InputEdge],
+    boundary_weight: f64,
+) -> Vec<Quadric> {
+    let mut quadric = vec![Quadric::default(); pos.len()];
+    for t in tris {
+        let p = t.map(|i| pos[i as usize]);
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let q = Quadric::plane(n.normalize_or_zero(), p[0], 0.5 * n.length());
-        for v in t {
-            work.quadric[v as usize] += q;
+        for &v in t {
+            quadric[v as usize] += q;
         }
     }
     if boundary_weight == 0.0 {
-        return;
+        return quadric;
     }
-    for &OpenEdge { a, b, face } in open_edges {
-        let t = work.faces[face as usize]
-            .corners
-            .map(|v| work.pos[v as usize]);
+    for &InputEdge { a, b, face, .. } in edges.iter().filter(|e| e.faces == 1) {
+        let t = tris[face as usize].map(|v| pos[v as usize]);
         let face_normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-        let (pa, pb) = (work.pos[a as usize], work.pos[b as usize]);
+        let (pa, pb) = (pos[a as usize], pos[b as usize]);
         let normal = (pb - pa).cross(face_normal).normalize_or_zero();
         let q = Quadric::plane(normal, pa, boundary_weight * pa.distance_squared(pb));
-        work.quadric[a as usize] += q;
-        work.quadric[b as usize] += q;
+        quadric[a as usize] += q;
+        quadric[b as usize] += q;
     }
+    quadric
 }
 
 /// How far (in edge lengths from the edge midpoint) the quadric's optimum may lie before it is

@@ -52,10 +52,16 @@ impl Quadric {
         (p.dot(ap) + 2.0 * self.b.dot(p) + self.c).max(0.0)
     }
 
-    /// The point minimising the error, or `None` when A is (nearly) singular.
+    /// The point minimising the error, or `None` when A is (nearly) singular. Solved by
+    /// cofactors (what `DMat3::inverse` does, computed once for the singularity test too).
     pub(super) fn minimizer(&self) -> Option<Point3> {
         let a = self.matrix();
-        let det = a.determinant();
+        let cof = [
+            a.y_axis.cross(a.z_axis),
+            a.z_axis.cross(a.x_axis),
+            a.x_axis.cross(a.y_axis),
+        ];
+        let det = a.x_axis.dot(cof[0]);
         let norm_sq = [self.a00, self.a11, self.a22]
             .iter()
             .map(|v| v * v)
@@ -65,7 +71,9 @@ impl Quadric {
         if det.is_nan() || det.abs() <= SINGULAR_RATIO * scale {
             return None;
         }
-        let x = a.inverse() * (-self.b);
+        let inv_det = 1.0 / det;
+        let inverse = DMat3::from_cols(cof[0] * inv_det, cof[1] * inv_det, cof[2] * inv_det);
+        let x = inverse.transpose() * (-self.b);
         x.is_finite().then_some(x)
     }
 
