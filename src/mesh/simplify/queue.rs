@@ -206,4 +206,48 @@ mod tests {
         let popped: Vec<Candidate> = std::iter::from_fn(|| q.pop()).collect();
         assert_eq!(popped, sorted(expected));
     }
+
+    #[test]
+    fn random_raises_lowers_removals_and_pops_match_a_sorted_list() {
+        // A naive reference: the current candidate of every queued edge, minimum popped.
+        let mut reference: Vec<Option<Candidate>> = vec![None; 64];
+        let mut q = Queue::new(64, Vec::new());
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        for _ in 0..20_000 {
+            let edge = next(64) as u32;
+            match next(10) {
+                0..=5 => {
+                    let c = Candidate {
+                        cost: next(40) as f64,
+                        u: next(3) as u32,
+                        v: 7,
+                        edge,
+                    };
+                    q.set(c);
+                    reference[edge as usize] = Some(c);
+                }
+                6 => {
+                    q.remove(edge);
+                    reference[edge as usize] = None;
+                }
+                _ => {
+                    let expected = reference
+                        .iter()
+                        .flatten()
+                        .copied()
+                        .reduce(|a, b| if b.before(&a) { b } else { a });
+                    assert_eq!(q.pop(), expected);
+                    if let Some(c) = expected {
+                        reference[c.edge as usize] = None;
+                    }
+                }
+            }
+        }
+    }
 }
