@@ -237,11 +237,13 @@ mod tests {
                     reference[edge as usize] = None;
                 }
                 _ => {
-                    let expected = reference
-                        .iter()
-                        .flatten()
-                        .copied()
-                        .reduce(|a, b| if b.before(&a) { b } else { a });
+                    let expected = reference.iter().flatten().copied().reduce(|a, b| {
+                        if b.before(&a) {
+                            b
+                        } else {
+                            a
+                        }
+                    });
                     assert_eq!(q.pop(), expected);
                     if let Some(c) = expected {
                         reference[c.edge as usize] = None;
