@@ -7,10 +7,7 @@
 # Usage: bash scripts/bench_fit.sh [DATA_DIR]   (default: ../shared/data, else /work/shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-data="${1:-}"
-if [ -z "$data" ]; then
-  if [ -d ../shared/data ]; then data=../shared/data; else data=/work/shared/data; fi
-fi
+source scripts/data_dir.sh "${1:-}"
 bunny="$data/stanford-bunny.obj"
 cargo build --release --quiet
 out=$(mktemp -d)

@@ -8,10 +8,7 @@
 #        GEOFIT_BIN=path/to/geofit bash scripts/bench_qem.sh   (time a given binary, no build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-data="${1:-}"
-if [ -z "$data" ]; then
-  if [ -d ../shared/data ]; then data=../shared/data; else data=/work/shared/data; fi
-fi
+source scripts/data_dir.sh "${1:-}"
 bin="${GEOFIT_BIN:-}"
 if [ -z "$bin" ]; then
   cargo build --release --quiet --bin geofit
