@@ -314,13 +314,9 @@ impl SubdivSurface {
         Ok(surface)
     }
 
-    /// Recomputes every patch's cached data from the current control points.
-    fn fill_cache(&mut self) {
-        self.fill_cache_from(None);
-    }
-
     /// Fills every patch's cached data: copied from `previous` for the patches kept from it
-    /// (their control points are the same), computed from the control points for the others.
+    /// (their control points are the same), computed from the current control points for the
+    /// others (all of them with `None`, as after moving control points).
     fn fill_cache_from(&mut self, previous: Option<&SubdivSurface>) {
         self.cache.clear();
         let pts = self.mesh.positions();
@@ -497,7 +493,7 @@ impl LimitSurface for SubdivSurface {
 
     fn set_control_points(&mut self, points: &[Point3]) {
         self.mesh.set_positions(points);
-        self.fill_cache();
+        self.fill_cache_from(None);
     }
 
     fn eval(&self, at: SurfaceParam) -> LimitEval {
