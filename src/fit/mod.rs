@@ -13,6 +13,7 @@ mod error;
 mod frozen;
 pub mod knot_placement;
 pub mod lsq_surface;
+mod normal_system;
 pub mod options;
 pub mod parameterize;
 pub mod patches;
