@@ -10,6 +10,115 @@ pub const MAX_DEGREE: usize = 7;
 pub struct KnotVector {
     degree: usize,
     knots: Vec<f64>,
+    /// The basis in power form, per span (see [`SpanPolynomials`]).
+    poly: SpanPolynomials,
+}
+
+/// The p + 1 non-zero basis functions of every non-empty span i as polynomials in the local
+/// parameter t = (u − knots[i]) / h_i, h_i = knots[i + 1] − knots[i]: N_{i−p+j}(u) =
+/// Σ_m c_jm t^m.
+///
+/// Why: evaluating them by Horner's rule (with the derivatives) takes a few multiply-adds per
+/// function and no division, where the Cox–de Boor triangle (A2.3) divides by knot differences
+/// at every call; basis evaluation is the innermost loop of every foot-point search and of the
+/// normal-equation assembly. The coefficients are the Taylor coefficients at the span start,
+/// c_jm = N^(m)(knots[i]) h^m / m!, taken from A2.3 once per knot vector; since
+/// |N^(m)| ≲ 1 / h^m they are of order one and the form is well conditioned on [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+struct SpanPolynomials {
+    /// Per span index i − p (i = p..n): (p + 1)² coefficients, row j = function, then 1/h_i
+    /// (zero for an empty span, which keeps to A2.3).
+    table: Vec<f64>,
+}
+
+/// m! / (m − r)! for m, r ≤ MAX_DEGREE: the factor of t^(m−r) in the r-th derivative of t^m.
+const FALLING: [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] = falling_factorials();
+
+const fn falling_factorials() -> [[f64; MAX_DEGREE + 1]; MAX_DEGREE + 1] {
+    let mut f = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+    let mut m = 0;
+    while m <= MAX_DEGREE {
+        let mut r = 0;
+        let mut v = 1.0;
+        while r <= m {
+            f[m][r] = v;
+            v *= (m - r) as f64;
+            r += 1;
+        }
+        m += 1;
+    }
+    f
+}
+
+impl SpanPolynomials {
+    fn stride(p: usize) -> usize {
+        (p + 1) * (p + 1) + 1
+    }
+
+    fn of(degree: usize, knots: &[f64]) -> SpanPolynomials {
+        let p = degree;
+        let n = knots.len() - p - 1;
+        let stride = Self::stride(p);
+        let mut table = vec![0.0; (n - p) * stride];
+        let mut ders = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+        for (i, entry) in (p..n).zip(table.chunks_exact_mut(stride)) {
+            let h = knots[i + 1] - knots[i];
+            if !(h > 0.0) {
+                continue;
+            }
+            basis_ders_cox_de_boor(p, knots, i, knots[i], p, &mut ders);
+            let mut scale = 1.0;
+            for m in 0..=p {
+                for j in 0..=p {
+                    entry[j * (p + 1) + m] = ders[m][j] * scale / FALLING[m][m];
+                }
+                scale *= h;
+            }
+            entry[stride - 1] = 1.0 / h;
+        }
+        SpanPolynomials { table }
+    }
+
+    /// Basis functions of `span` and derivatives up to `d` at `u` into `out` (rows 0..=d,
+    /// entries from N on zero), or false for an empty or unknown span.
+    fn eval<const N: usize>(
+        &self,
+        knots: &[f64],
+        span: usize,
+        u: f64,
+        d: usize,
+        out: &mut [[f64; MAX_DEGREE + 1]],
+    ) -> bool {
+        let p = N - 1;
+        let stride = Self::stride(p);
+        let Some(entry) = span
+            .checked_sub(p)
+            .and_then(|s| self.table.get(s * stride..(s + 1) * stride))
+        else {
+            return false;
+        };
+        let inv_h = entry[stride - 1];
+        if inv_h == 0.0 {
+            return false;
+        }
+        let t = (u - knots[span]) * inv_h;
+        for row in out.iter_mut().take(d + 1) {
+            row.fill(0.0);
+        }
+        let mut scale = 1.0;
+        for (r, row) in out.iter_mut().enumerate().take(d.min(p) + 1) {
+            for j in 0..N {
+                let c = &entry[j * N..(j + 1) * N];
+                let mut acc = 0.0;
+                for m in (r..N).rev() {
+                    acc = acc * t + FALLING[m][r] * c[m];
+                }
+                row[j] = acc * scale;
+            }
+            scale *= inv_h;
+        }
+        true
+    }
 }
 
 impl KnotVector {
@@ -41,12 +150,16 @@ impl KnotVector {
             });
         }
         check_multiplicity(degree, &knots)?;
-        let kv = KnotVector { degree, knots };
-        let (start, end) = kv.domain();
+        let (start, end) = (knots[degree], knots[knots.len() - degree - 1]);
         if end <= start {
             return Err(SplineError::EmptyDomain { start, end });
         }
-        Ok(kv)
+        let poly = SpanPolynomials::of(degree, &knots);
+        Ok(KnotVector {
+            degree,
+            knots,
+            poly,
+        })
     }
 
     /// A clamped (open) knot vector with `n` basis functions and uniform interior knots on
@@ -116,17 +229,18 @@ impl KnotVector {
     pub fn basis_ders(&self, span: usize, u: f64, d: usize, out: &mut [[f64; MAX_DEGREE + 1]]) {
         let u = self.clamp(u);
         let k = &self.knots;
-        // One instance per degree: the scratch tables then have the degree's own size and the
-        // loops fixed bounds, which makes this (the inner loop of every foot-point search and
-        // of the normal-equation assembly) several times cheaper than tables of MAX_DEGREE.
-        match self.degree {
-            1 => basis_ders_n::<2>(k, span, u, d, out),
-            2 => basis_ders_n::<3>(k, span, u, d, out),
-            3 => basis_ders_n::<4>(k, span, u, d, out),
-            4 => basis_ders_n::<5>(k, span, u, d, out),
-            5 => basis_ders_n::<6>(k, span, u, d, out),
-            6 => basis_ders_n::<7>(k, span, u, d, out),
-            _ => basis_ders_n::<{ MAX_DEGREE + 1 }>(k, span, u, d, out),
+        // One instance per degree: fixed loop bounds let the compiler unroll the Horner sums.
+        let done = match self.degree {
+            1 => self.poly.eval::<2>(k, span, u, d, out),
+            2 => self.poly.eval::<3>(k, span, u, d, out),
+            3 => self.poly.eval::<4>(k, span, u, d, out),
+            4 => self.poly.eval::<5>(k, span, u, d, out),
+            5 => self.poly.eval::<6>(k, span, u, d, out),
+            6 => self.poly.eval::<7>(k, span, u, d, out),
+            _ => self.poly.eval::<{ MAX_DEGREE + 1 }>(k, span, u, d, out),
+        };
+        if !done {
+            basis_ders_cox_de_boor(self.degree, k, span, u, d, out);
         }
     }
 
@@ -136,6 +250,27 @@ impl KnotVector {
         let mut out = [[0.0; MAX_DEGREE + 1]; 1];
         self.basis_ders(span, u, 0, &mut out);
         (span - self.degree, out[0])
+    }
+}
+
+/// A2.3 for degree `p`: see [`basis_ders_n`].
+fn basis_ders_cox_de_boor(
+    p: usize,
+    k: &[f64],
+    span: usize,
+    u: f64,
+    d: usize,
+    out: &mut [[f64; MAX_DEGREE + 1]],
+) {
+    // One instance per degree: the scratch tables then have the degree's own size.
+    match p {
+        1 => basis_ders_n::<2>(k, span, u, d, out),
+        2 => basis_ders_n::<3>(k, span, u, d, out),
+        3 => basis_ders_n::<4>(k, span, u, d, out),
+        4 => basis_ders_n::<5>(k, span, u, d, out),
+        5 => basis_ders_n::<6>(k, span, u, d, out),
+        6 => basis_ders_n::<7>(k, span, u, d, out),
+        _ => basis_ders_n::<{ MAX_DEGREE + 1 }>(k, span, u, d, out),
     }
 }
 
