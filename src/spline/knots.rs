@@ -473,5 +473,43 @@ mod tests {
             let fd2 = (value(u + h, 1) - value(u - h, 1)) / (2.0 * h);
             prop_assert!((fd2 - value(u, 2)).abs() < 1e-3, "second derivative {} vs {}", fd2, value(u, 2));
         }
+
+        #[test]
+        fn power_form_matches_cox_de_boor(
+            p in 1usize..=MAX_DEGREE,
+            gaps in proptest::collection::vec(0u8..4, 1..12),
+            at in 0.0f64..1.0,
+        ) {
+            // Interior knots from integer gaps (0 repeats a knot), multiplicity at most p + 1.
+            let mut knots = vec![0.0; p + 1];
+            let mut t = 0.0;
+            for g in &gaps {
+                t += f64::from(*g);
+                let repeats = knots.iter().filter(|&&k| k == t).count();
+                if t > 0.0 && repeats < p {
+                    knots.push(t);
+                }
+            }
+            let end = t + 1.0;
+            knots.extend(std::iter::repeat_n(end, p + 1));
+            let k = KnotVector::try_new(p, knots).expect("valid knots");
+            let u = at * end;
+            let span = k.find_span(u);
+            let mut fast = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+            let mut exact = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+            k.basis_ders(span, u, p, &mut fast);
+            basis_ders_cox_de_boor(p, k.knots(), span, u, p, &mut exact);
+            for order in 0..=p {
+                // Derivatives scale like 1/h^order: compare relative to the largest entry.
+                let size = exact[order].iter().fold(1.0f64, |m, x| m.max(x.abs()));
+                for j in 0..=MAX_DEGREE {
+                    prop_assert!(
+                        (fast[order][j] - exact[order][j]).abs() <= 1e-11 * size,
+                        "degree {} order {} function {}: {} vs {}",
+                        p, order, j, fast[order][j], exact[order][j]
+                    );
+                }
+            }
+        }
     }
 }
