@@ -174,6 +174,29 @@ fn adaptive_splitting_meets_the_tolerance() {
     }
 }
 
+#[test]
+fn knots_far_from_the_tolerance_are_split_after_one_solve() {
+    let points = dome(50, &mut Rng(5));
+    // Which iterations refined, for a failing-share threshold of 0 (split as soon as any
+    // patch fails) and 1 (always solve twice per knot vector).
+    let refined = |share: f64| {
+        let opts = LsqSurfaceOptions::default()
+            .with_control(4, 4)
+            .with_tolerance(0.01, TolMode::Exact)
+            .with_max_iterations(6)
+            .with_early_split_share(share)
+            .with_param(ParamOptions::default().with_view(Vec3::Z));
+        let mut fit = LsqSurfaceFitter::try_new(&points, opts).unwrap();
+        fit.run().unwrap();
+        fit.history().iter().map(|r| r.refined).collect::<Vec<_>>()
+    };
+    assert_eq!(refined(0.0), [true, true, true, true, true, false]);
+    assert_eq!(refined(1.0), [false, true, false, true, false, false]);
+    let bad = LsqSurfaceOptions::default().with_early_split_share(1.5);
+    let err = LsqSurfaceFitter::try_new(&points, bad).err().expect("rejected");
+    assert!(err.to_string().contains("early_split_share"), "{err}");
+}
+
 /// A sheet folded over itself along x: z = 0 for x in [0, 1], then back over x in [0.5, 1]
 /// at z = 0.3.
 fn folded_sheet() -> Vec<Point3> {

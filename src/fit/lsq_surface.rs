@@ -55,7 +55,8 @@ pub struct LsqSurfaceOptions {
     /// Solves (each followed by parameter correction) per knot vector. Default 2.
     pub solves_per_knots: usize,
     /// Share of the non-empty patches above which the fit splits right after the first solve
-    /// on a knot vector, without the further solves of `solves_per_knots`. Default 0.25.
+    /// on a knot vector, without the further solves of `solves_per_knots` (not with
+    /// `fixed_knots`, which never splits). Default 0.25.
     ///
     /// Why: while most patches miss TOL (the coarse start of an adaptive fit) the split is
     /// certain, and a second solve would only refine parameters that the finer surface corrects
@@ -440,7 +441,7 @@ impl Fitter for LsqSurfaceFitter {
         } else if self.history.len() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
         } else if self.solves_at_knots < self.opts.solves_per_knots
-            && failing_share(&errors) <= self.opts.early_split_share
+            && (self.opts.fixed_knots || failing_share(&errors) <= self.opts.early_split_share)
         {
             FitStatus::Running
         } else if self.opts.fixed_knots {
