@@ -193,7 +193,9 @@ fn knots_far_from_the_tolerance_are_split_after_one_solve() {
     assert_eq!(refined(0.0), [true, true, true, true, true, false]);
     assert_eq!(refined(1.0), [false, true, false, true, false, false]);
     let bad = LsqSurfaceOptions::default().with_early_split_share(1.5);
-    let err = LsqSurfaceFitter::try_new(&points, bad).err().expect("rejected");
+    let err = LsqSurfaceFitter::try_new(&points, bad)
+        .err()
+        .expect("rejected");
     assert!(err.to_string().contains("early_split_share"), "{err}");
 }
 

@@ -15,6 +15,7 @@ pub mod knot_placement;
 pub mod lsq_surface;
 mod normal_system;
 pub mod options;
+mod parallel;
 pub mod parameterize;
 pub mod patches;
 pub mod refine;

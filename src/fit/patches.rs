@@ -260,13 +260,17 @@ pub(crate) fn correct_parameters(
     let opts = NewtonOptions::default()
         .with_max_iterations(iterations)
         .with_param_tolerance(1e-7);
-    for ((p, t), d) in points.iter().zip(uv.iter_mut()).zip(dist.iter_mut()) {
-        let near = surface.closest_point(*p, t[0], t[1], opts);
-        *t = [near.u, near.v];
-        let e = *p - near.point;
-        let len = e.length();
-        *d = if e.dot(near.normal) < 0.0 { -len } else { len };
-    }
+    // Each point's foot point depends on that point alone: the same result on any number of
+    // threads.
+    super::parallel::zip_chunks(points, uv, dist, |points, uv, dist| {
+        for ((p, t), d) in points.iter().zip(uv.iter_mut()).zip(dist.iter_mut()) {
+            let near = surface.closest_point(*p, t[0], t[1], opts);
+            *t = [near.u, near.v];
+            let e = *p - near.point;
+            let len = e.length();
+            *d = if e.dot(near.normal) < 0.0 { -len } else { len };
+        }
+    });
 }
 
 #[cfg(test)]
