@@ -231,3 +231,33 @@ fn cli_fit_scheme_bspline_writes_the_report() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_mostly_failing_knot_vector_is_split_early() {
+    let pts = wave(40);
+    // The iterations that refined, for an early split after 2 iterations at any failing share
+    // and for none (split only on a stall or after `iterations_per_knots`).
+    let refined = |after: usize, share: f64| {
+        let opts = GeometricSurfaceOptions::default()
+            .with_control(4, 4)
+            .with_tolerance(1e-3, TolMode::Exact)
+            .with_early_split(after, share)
+            .with_max_iterations(8)
+            .with_param(top());
+        let mut fit = GeometricSurfaceFitter::try_new(&pts, opts).unwrap();
+        fit.run().unwrap();
+        let h = fit.history();
+        h.iter()
+            .filter(|r| r.refined)
+            .map(|r| r.iter)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(refined(2, 0.0), [2, 4, 6]);
+    let late = refined(usize::MAX, 1.0);
+    assert!(late.first().is_none_or(|&i| i > 2), "{late:?}");
+    let bad = GeometricSurfaceOptions::default().with_early_split(2, -0.1);
+    let err = GeometricSurfaceFitter::try_new(&pts, bad)
+        .err()
+        .expect("rejected");
+    assert!(err.to_string().contains("early_split_share"), "{err}");
+}

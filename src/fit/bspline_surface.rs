@@ -12,7 +12,7 @@ use super::lsq_surface::{check_common, plane_surface, LsqSurfaceFitter, LsqSurfa
 use super::options::Acceleration;
 use super::parameterize::{check_points, parameterize, ParamOptions, Parameterization};
 use super::patches::{
-    correct_parameters, patch_errors, split_worst, Criterion, PatchGrid, TolMode,
+    correct_parameters, failing_share, patch_errors, split_worst, Criterion, PatchGrid, TolMode,
 };
 use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
 use crate::geom::{Aabb, Point3, Vec3};
@@ -38,6 +38,17 @@ pub struct GeometricSurfaceOptions {
     /// Iterations on one knot vector before refining, unless the error stalls earlier
     /// (relative E_rms gain under 1 %). Default 12.
     pub iterations_per_knots: usize,
+    /// Refine after this many iterations on a knot vector while more than `early_split_share`
+    /// of the patches holding points miss TOL. Default 4.
+    ///
+    /// Why: an iteration costs about the same on any knot vector (its work is per data point),
+    /// so iterating a coarse surface that must be split anyway is the dearest way to lower the
+    /// error. On bun000.ply at tol 0.1 % (noisy): 47 iterations and 11,067 control points
+    /// instead of 64 and 10,440; at tol 0.05 % E_max 0.083 % instead of 0.123 % when both stop
+    /// at the 40,000 cap.
+    pub early_split_after: usize,
+    /// See `early_split_after`. Default 0.5.
+    pub early_split_share: f64,
     /// Cap on the control-point count. Default 40,000.
     pub max_control_points: usize,
     /// In [`TolMode::Noisy`], a patch with fewer points than this is judged on the points of
@@ -71,6 +82,8 @@ impl Default for GeometricSurfaceOptions {
             tol_mode: TolMode::Noisy,
             acceleration: Acceleration::Anderson { depth: 5 },
             iterations_per_knots: 12,
+            early_split_after: 4,
+            early_split_share: 0.5,
             max_control_points: 40_000,
             min_sample: 16,
             max_iterations: 200,
@@ -106,6 +119,13 @@ impl GeometricSurfaceOptions {
     /// Sets the acceleration.
     pub fn with_acceleration(mut self, acceleration: Acceleration) -> Self {
         self.acceleration = acceleration;
+        self
+    }
+    /// Sets when a knot vector is split early: after `iterations` while more than `share` of
+    /// the patches fail.
+    pub fn with_early_split(mut self, iterations: usize, share: f64) -> Self {
+        self.early_split_after = iterations;
+        self.early_split_share = share;
         self
     }
     /// Sets the iteration cap.
@@ -161,6 +181,12 @@ impl GeometricSurfaceFitter {
                     reason: format!("{depth} is outside 1..=20"),
                 });
             }
+        }
+        if !(0.0..=1.0).contains(&opts.early_split_share) {
+            return Err(FitError::InvalidOption {
+                name: "early_split_share",
+                reason: format!("{} is outside 0..=1", opts.early_split_share),
+            });
         }
         check_points(points, opts.degree + 1)?;
         let mut param = parameterize(points, &opts.param)?;
@@ -346,7 +372,10 @@ impl Fitter for GeometricSurfaceFitter {
             FitStatus::Converged
         } else if self.history.len() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
-        } else if !(stalled || self.iters_at_knots >= self.opts.iterations_per_knots) {
+        } else if !(stalled || self.iters_at_knots >= self.opts.iterations_per_knots)
+            && !(self.iters_at_knots >= self.opts.early_split_after
+                && failing_share(&errors) > self.opts.early_split_share)
+        {
             FitStatus::Running
         } else if self.opts.fixed_knots {
             if stalled {

@@ -18,7 +18,8 @@
 use super::normal_system::{for_cell_pairs, span_gram, NormalSystem};
 use super::parameterize::{parameterize, ParamOptions, Parameterization};
 use super::patches::{
-    correct_parameters, patch_errors, split_worst, Criterion, PatchError, PatchGrid, TolMode,
+    correct_parameters, failing_share, patch_errors, split_worst, Criterion, PatchError, PatchGrid,
+    TolMode,
 };
 use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
 use crate::geom::{Aabb, Point3};
@@ -486,13 +487,6 @@ impl Fitter for LsqSurfaceFitter {
     fn stats(&self) -> ErrorStats {
         ErrorStats::from_distances(&self.dist, self.diagonal)
     }
-}
-
-/// Share of the patches holding points that miss TOL.
-fn failing_share(errors: &[PatchError]) -> f64 {
-    let judged = errors.iter().filter(|e| e.count > 0).count();
-    let failing = errors.iter().filter(|e| !e.pass).count();
-    failing as f64 / judged.max(1) as f64
 }
 
 /// The factors of β2 and β3 of every patch: 1/ρ and ρ (SPEC §2), with ρ the relative point

@@ -188,6 +188,13 @@ pub(crate) fn patch_errors(
         .collect()
 }
 
+/// Share of the patches holding points that miss TOL (0 when no patch holds points).
+pub(crate) fn failing_share(errors: &[PatchError]) -> f64 {
+    let judged = errors.iter().filter(|e| e.count > 0).count();
+    let failing = errors.iter().filter(|e| !e.pass).count();
+    failing as f64 / judged.max(1) as f64
+}
+
 impl PatchError {
     /// An empty patch: nothing to judge, it passes.
     fn default_pass() -> PatchError {
