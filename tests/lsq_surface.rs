@@ -190,8 +190,13 @@ fn knots_far_from_the_tolerance_are_split_after_one_solve() {
         fit.run().unwrap();
         fit.history().iter().map(|r| r.refined).collect::<Vec<_>>()
     };
-    assert_eq!(refined(0.0), [true, true, true, true, true, false]);
-    assert_eq!(refined(1.0), [false, true, false, true, false, false]);
+    // Threshold 0: every iteration but the last refines.
+    let early = refined(0.0);
+    assert!(early.len() >= 4, "{early:?}");
+    assert!(early[..early.len() - 1].iter().all(|&r| r), "{early:?}");
+    // Threshold 1: two solves per knot vector, so refinements alternate.
+    let late = refined(1.0);
+    assert_eq!(late[..4], [false, true, false, true], "{late:?}");
     let bad = LsqSurfaceOptions::default().with_early_split_share(1.5);
     let err = LsqSurfaceFitter::try_new(&points, bad)
         .err()

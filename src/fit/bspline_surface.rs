@@ -389,6 +389,7 @@ impl Fitter for GeometricSurfaceFitter {
                 &grid,
                 &errors,
                 self.opts.max_control_points,
+                f64::INFINITY,
             );
             refined = inserted > 0;
             self.iters_at_knots = 0;

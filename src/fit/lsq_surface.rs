@@ -448,11 +448,19 @@ impl Fitter for LsqSurfaceFitter {
         } else if self.opts.fixed_knots {
             FitStatus::MaxIterations
         } else {
+            // Halving a span divides the error by about 2^(p + 1) (see split_worst).
+            let p = self
+                .surface
+                .knots_u()
+                .degree()
+                .min(self.surface.knots_v().degree());
+            let quarter_above = tol * 2f64.powi(p as i32 + 1);
             let inserted = split_worst(
                 &mut self.surface,
                 &grid,
                 &errors,
                 self.opts.max_control_points,
+                quarter_above,
             );
             refined = inserted > 0;
             self.solves_at_knots = 0;

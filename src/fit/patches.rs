@@ -206,42 +206,69 @@ impl PatchError {
     }
 }
 
-/// Splits failing patches worst first by inserting a knot in the middle of their u and v spans
-/// (each span once), while the control-point count stays within `max_control`. Returns the number of knots inserted.
+/// Splits failing patches worst first by inserting knots into their u and v spans (each span
+/// once), while the control-point count stays within `max_control`: the midpoint, or the three
+/// quarter points when the patch's ERR exceeds `quarter_above`. Returns the number of knots
+/// inserted.
+///
+/// Why quarters: on smooth data a degree-p fit's error falls like h^(p + 1), so halving a span
+/// divides ERR by about 2^(p + 1); a patch whose ERR exceeds that many times TOL needs two
+/// halvings anyway, and doing both at once saves a round of solves (the least-squares fit
+/// passes 2^(p + 1)·TOL; the geometric fit, whose errors early on are those of an unconverged
+/// iteration, passes infinity).
 pub(crate) fn split_worst(
     surface: &mut BSplineSurface,
     grid: &PatchGrid,
     errors: &[PatchError],
     max_control: usize,
+    quarter_above: f64,
 ) -> usize {
     let mut failing: Vec<usize> = (0..errors.len()).filter(|&i| !errors[i].pass).collect();
     failing.sort_by(|&a, &b| errors[b].err.total_cmp(&errors[a].err).then(a.cmp(&b)));
     let (mut nu, mut nv) = surface.num_control();
-    let mut split_u = vec![false; grid.u.len()];
-    let mut split_v = vec![false; grid.v.len()];
+    // Pieces each span is cut into (1: left alone).
+    let mut pieces_u = vec![1usize; grid.u.len()];
+    let mut pieces_v = vec![1usize; grid.v.len()];
     for patch in failing {
         let (cu, cv) = (patch / grid.v.len(), patch % grid.v.len());
-        if !split_u[cu] && (nu + 1) * nv <= max_control {
-            split_u[cu] = true;
-            nu += 1;
+        let want = if errors[patch].err > quarter_above {
+            4
+        } else {
+            2
+        };
+        if pieces_u[cu] < want {
+            let added = want - pieces_u[cu];
+            if (nu + added) * nv <= max_control {
+                pieces_u[cu] = want;
+                nu += added;
+            } else if pieces_u[cu] == 1 && (nu + 1) * nv <= max_control {
+                pieces_u[cu] = 2;
+                nu += 1;
+            }
         }
-        if !split_v[cv] && nu * (nv + 1) <= max_control {
-            split_v[cv] = true;
-            nv += 1;
+        if pieces_v[cv] < want {
+            let added = want - pieces_v[cv];
+            if nu * (nv + added) <= max_control {
+                pieces_v[cv] = want;
+                nv += added;
+            } else if pieces_v[cv] == 1 && nu * (nv + 1) <= max_control {
+                pieces_v[cv] = 2;
+                nv += 1;
+            }
         }
     }
-    let mids = |spans: &Spans, kv: &KnotVector, marks: &[bool]| -> Vec<f64> {
+    let cuts = |spans: &Spans, kv: &KnotVector, pieces: &[usize]| -> Vec<f64> {
         let k = kv.knots();
         (0..spans.len())
-            .filter(|&c| marks[c])
-            .map(|c| {
+            .flat_map(|c| {
                 let s = spans.knot_index(c);
-                0.5 * (k[s] + k[s + 1])
+                let (a, b, n) = (k[s], k[s + 1], pieces[c]);
+                (1..n).map(move |i| a + (b - a) * i as f64 / n as f64)
             })
             .collect()
     };
-    let new_u = mids(&grid.u, surface.knots_u(), &split_u);
-    let new_v = mids(&grid.v, surface.knots_v(), &split_v);
+    let new_u = cuts(&grid.u, surface.knots_u(), &pieces_u);
+    let new_v = cuts(&grid.v, surface.knots_v(), &pieces_v);
     let mut inserted = 0;
     for t in new_u {
         inserted += usize::from(surface.insert_knot_u(t).is_ok());
@@ -358,5 +385,44 @@ mod tests {
         assert!(e.iter().all(|p| p.pass), "{e:?}");
         // The exact mode never pools.
         assert!(!judge(&uv, &dist, TolMode::Exact, 16)[4].pass);
+    }
+
+    #[test]
+    fn far_failing_patches_are_quartered() {
+        let fail = |err: f64| PatchError {
+            count: 10,
+            err,
+            pass: false,
+        };
+        let mut errors = vec![PatchError::default_pass(); 9];
+        errors[0] = fail(5.0); // beyond quarter_above: u and v spans cut in four
+        errors[8] = fail(2.0); // within: halved
+        let mut s = grid3();
+        let grid = PatchGrid::of(&s);
+        let inserted = split_worst(&mut s, &grid, &errors, usize::MAX, 4.0);
+        assert_eq!(inserted, 8);
+        let u: Vec<f64> = s.knots_u().knots().to_vec();
+        let third = 1.0 / 3.0;
+        let expected = [
+            0.0,
+            0.0,
+            third / 4.0,
+            third / 2.0,
+            third * 3.0 / 4.0,
+            third,
+            2.0 * third,
+            2.5 * third,
+            1.0,
+            1.0,
+        ];
+        assert!(
+            u.iter().zip(&expected).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{u:?}"
+        );
+        assert_eq!(s.knots_v().knots().len(), u.len());
+        // Within a budget of 5 × 4 control points: the worst patch is only halved.
+        let mut s = grid3();
+        let inserted = split_worst(&mut s, &grid, &errors, 20, 4.0);
+        assert_eq!(s.num_control(), (5, 4), "{inserted}");
     }
 }
