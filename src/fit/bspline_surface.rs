@@ -367,15 +367,15 @@ impl Fitter for GeometricSurfaceFitter {
             },
         );
         let stalled = self.stats().e_rms > 0.99 * rms_before;
+        let split_early = self.iters_at_knots >= self.opts.early_split_after
+            && failing_share(&errors) > self.opts.early_split_share;
+        let due = stalled || split_early || self.iters_at_knots >= self.opts.iterations_per_knots;
         let mut refined = false;
         self.status = if errors.iter().all(|e| e.pass) {
             FitStatus::Converged
         } else if self.history.len() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
-        } else if !(stalled || self.iters_at_knots >= self.opts.iterations_per_knots)
-            && !(self.iters_at_knots >= self.opts.early_split_after
-                && failing_share(&errors) > self.opts.early_split_share)
-        {
+        } else if !due {
             FitStatus::Running
         } else if self.opts.fixed_knots {
             if stalled {
