@@ -90,3 +90,21 @@ fn corrupt_files_exit_1_with_one_line_on_stderr() {
         assert!(err.contains(needle), "{name}: {err}");
     }
 }
+
+#[test]
+fn a_closed_output_pipe_is_not_a_crash() {
+    // The reader goes away before geofit writes (as `geofit info scan.ply | head -1` does once
+    // head has its line): the command must finish normally instead of panicking.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_geofit"))
+        .arg("info")
+        .arg(data_file("fandisk.obj"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the geofit binary runs");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("geofit finishes");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

@@ -257,14 +257,18 @@ fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), Stri
         reconstruction,
     } = setup;
     if let (false, Some(r)) = (args.quiet, &reconstruction) {
-        println!(
+        outln!(
             "reconstructed {} surface ({}): {} triangles, {} outliers removed, {:.3} s",
-            r.kind, r.method, r.triangles, r.outliers, r.seconds
+            r.kind,
+            r.method,
+            r.triangles,
+            r.outliers,
+            r.seconds
         );
     }
     let s = fitter.stats();
     if !args.quiet {
-        println!(
+        outln!(
             "start  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%  ({} points, precompute {:.3} s)",
             fitter.num_control_points(),
             s.e_avg_pct,
@@ -278,7 +282,7 @@ fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), Stri
     loop {
         let status = fitter.step().map_err(|e| e.to_string())?;
         if let (false, Some(r)) = (args.quiet, fitter.history().last()) {
-            println!(
+            outln!(
                 "iter {:>3}  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%  {:7.1} ms{}",
                 r.iter,
                 r.control_points,
@@ -298,7 +302,7 @@ fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), Stri
     let within = report.within_tolerance_pct.map_or(String::new(), |w| {
         format!(" ({w:.2}% of points within E_max tolerance)")
     });
-    println!(
+    outln!(
         "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%{}, precompute {:.2} s, fit {:.2} s, total {:.2} s",
         report.scheme,
         if report.converged { "converged" } else { "stopped" },

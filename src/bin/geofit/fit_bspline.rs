@@ -275,7 +275,7 @@ pub fn run(common: Common, args: &BsplineArgs) -> Result<(), String> {
         }
     };
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
-    println!("{text}");
+    outln!("{text}");
     if let Some(path) = common.json {
         std::fs::write(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
     }

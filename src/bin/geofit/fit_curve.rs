@@ -178,7 +178,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
     match &args.json {
         Some(path) => std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?,
-        None => println!(
+        None => outln!(
             "{} control points, E_max {:.5} %, E_rms {:.5} %, {:?}, {:.1} ms",
             curve.control_points().len(),
             stats.e_max_pct,

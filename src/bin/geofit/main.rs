@@ -3,6 +3,13 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+/// `println!` that survives a closed pipe (see [`output::write_line`]).
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::output::write_line(format_args!($($arg)*))
+    };
+}
+
 mod export_samples;
 mod fit;
 mod fit_bspline;

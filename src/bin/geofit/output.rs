@@ -18,6 +18,19 @@ pub fn print_json(report: &impl Serialize, compact: bool) -> Result<(), String> 
         serde_json::to_string_pretty(report)
     }
     .map_err(|e| e.to_string())?;
-    println!("{text}");
+    write_line(format_args!("{text}"));
     Ok(())
+}
+
+/// Writes one line to standard output (what `outln!` expands to). A reader that has gone away
+/// (a closed pipe, as in `geofit info scan.ply | head -1`) is not an error: the rest of the
+/// output is not read, and the command still writes its files; `println!` would panic.
+pub fn write_line(line: std::fmt::Arguments) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = writeln!(out, "{line}") {
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            eprintln!("geofit: standard output: {e}");
+        }
+    }
 }

@@ -64,7 +64,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let mut out = std::io::BufWriter::new(file);
     geofit::io::write_obj(&mesh, &mut out)
         .map_err(|e| format!("{}: {e}", args.output.display()))?;
-    println!(
+    outln!(
         "{}: {} vertices, {} faces after {} {:?} step(s){}",
         args.output.display(),
         mesh.num_vertices(),
