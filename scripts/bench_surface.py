@@ -367,10 +367,29 @@ def main():
             row("scipy SmoothBivariateSpline", nc, scipy_surface(sp), w, c, "default s")
         except Exception as e:  # noqa: BLE001
             print(f"scipy SmoothBivariateSpline: failed: {e}")
+    equal_accuracy(rows)
     if args.json:
         keys = ("method", "control_points", "e_max_pct", "e_rms_pct", "e_avg_pct", "wall_s", "cpu_s", "note")
         with open(args.json, "w") as f:
             json.dump([dict(zip(keys, r)) for r in rows], f, indent=1)
+
+def equal_accuracy(rows):
+    """For every peer surface, the cheapest geofit surface (CPU s, one thread) at least as
+    accurate on both E_max and E_rms: the time each takes to reach the peer's accuracy."""
+    fits = [r for r in rows if r[0].startswith("geofit")]
+    print("\n# equal accuracy: the cheapest geofit fit with E_max and E_rms at most the peer's")
+    for name, ctrl, emax, erms, _, _, cpu, _ in rows:
+        if name.startswith("geofit"):
+            continue
+        good = [f for f in fits if f[2] <= emax and f[3] <= erms]
+        if not good:
+            print(f"{name:40s} {ctrl:6d}  E_max {emax:6.3f} E_rms {erms:6.4f} {cpu:6.2f} s  <- no geofit fit")
+            continue
+        best = min(good, key=lambda f: f[6])
+        print(f"{name:40s} {ctrl:6d}  E_max {emax:6.3f} E_rms {erms:6.4f} {cpu:6.2f} s  <- "
+              f"{best[0]} {best[1]}: E_max {best[2]:.3f} E_rms {best[3]:.4f} {best[6]:.2f} s "
+              f"({cpu / max(best[6], 1e-9):.1f}x)")
+
 
 if __name__ == "__main__":
     main()
