@@ -276,8 +276,15 @@ impl GeometricSurfaceFitter {
             .zip(&self.active)
             .filter(|x| *x.1)
         {
+            // One basis evaluation gives both the foot point and the weights.
             let b = self.surface.basis(t[0], t[1]);
-            let foot = self.surface.eval(t[0], t[1]);
+            let ctrl = self.surface.control_points();
+            let mut foot = Vec3::ZERO;
+            for r in 0..=p {
+                for s in 0..=q {
+                    foot += b.bu[r] * b.bv[s] * ctrl[(b.first_u + r) * nv + b.first_v + s];
+                }
+            }
             let e = *pt - foot;
             for r in 0..=p {
                 for s in 0..=q {
