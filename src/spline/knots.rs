@@ -1,4 +1,5 @@
 use super::SplineError;
+use std::sync::OnceLock;
 
 /// Largest supported B-spline degree. Higher degrees are numerically poor for fitting and the
 /// fixed-size scratch arrays below depend on it.
@@ -6,10 +7,26 @@ pub const MAX_DEGREE: usize = 7;
 
 /// A non-decreasing knot sequence with its degree p. The parameter domain is
 /// `[knots[p], knots[len - p - 1]]`, and there are `len - p - 1` basis functions.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct KnotVector {
     degree: usize,
     knots: Vec<f64>,
+    /// Evaluation tables, built at the first basis evaluation: knot insertion makes a new
+    /// knot vector per knot, and the vectors in between (a batch of insertions, or one of a
+    /// curve fit's refinements) are never evaluated.
+    tables: OnceLock<SpanTables>,
+}
+
+/// Two knot vectors are equal when their degrees and knots are (the tables follow from them).
+impl PartialEq for KnotVector {
+    fn eq(&self, other: &Self) -> bool {
+        self.degree == other.degree && self.knots == other.knots
+    }
+}
+
+/// What evaluation needs beyond the knots.
+#[derive(Clone, Debug)]
+struct SpanTables {
     /// The basis in power form, per span (see [`SpanPolynomials`]).
     poly: SpanPolynomials,
     /// Where to start looking for a parameter's span (see [`SpanLookup`]).
@@ -20,7 +37,7 @@ pub struct KnotVector {
 /// its start: [`KnotVector::find_span`] walks from there, a step or two on any knot vector
 /// the fits make, instead of a binary search over all knots (which was a sixth of the time
 /// of a B-spline surface fit's foot-point search).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 struct SpanLookup {
     start: f64,
     /// Buckets per unit parameter.
@@ -65,7 +82,7 @@ impl SpanLookup {
 /// normal-equation assembly. The coefficients are the Taylor coefficients at the span start,
 /// c_jm = N^(m)(knots[i]) h^m / m!, taken from A2.3 once per knot vector; since
 /// |N^(m)| ≲ 1 / h^m they are of order one and the form is well conditioned on [0, 1].
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 struct SpanPolynomials {
     /// Per span index i − p (i = p..n): (p + 1)² coefficients, row j = function, then 1/h_i
     /// (zero for an empty span, which keeps to A2.3).
@@ -195,13 +212,10 @@ impl KnotVector {
         if end <= start {
             return Err(SplineError::EmptyDomain { start, end });
         }
-        let poly = SpanPolynomials::of(degree, &knots);
-        let lookup = SpanLookup::of(degree, &knots);
         Ok(KnotVector {
             degree,
             knots,
-            poly,
-            lookup,
+            tables: OnceLock::new(),
         })
     }
 
@@ -262,8 +276,11 @@ impl KnotVector {
             return i;
         }
         // The largest i with knots[i] <= u: walk from the bucket's span (stepping back first
-        // if rounding put u in the next bucket), else search.
-        let table = &self.lookup;
+        // if rounding put u in the next bucket), else search (also before the tables exist).
+        let Some(tables) = self.tables.get() else {
+            return self.knots[self.degree..=n].partition_point(|&k| k <= u) + self.degree - 1;
+        };
+        let table = &tables.lookup;
         let bucket = ((u - table.start) * table.scale) as usize;
         let mut i = table.spans[bucket.min(table.spans.len() - 1)];
         while i > self.degree && self.knots[i] > u {
@@ -285,15 +302,22 @@ impl KnotVector {
     pub fn basis_ders(&self, span: usize, u: f64, d: usize, out: &mut [[f64; MAX_DEGREE + 1]]) {
         let u = self.clamp(u);
         let k = &self.knots;
+        let poly = &self
+            .tables
+            .get_or_init(|| SpanTables {
+                poly: SpanPolynomials::of(self.degree, k),
+                lookup: SpanLookup::of(self.degree, k),
+            })
+            .poly;
         // One instance per degree: fixed loop bounds let the compiler unroll the Horner sums.
         let done = match self.degree {
-            1 => self.poly.eval::<2>(k, span, u, d, out),
-            2 => self.poly.eval::<3>(k, span, u, d, out),
-            3 => self.poly.eval::<4>(k, span, u, d, out),
-            4 => self.poly.eval::<5>(k, span, u, d, out),
-            5 => self.poly.eval::<6>(k, span, u, d, out),
-            6 => self.poly.eval::<7>(k, span, u, d, out),
-            _ => self.poly.eval::<{ MAX_DEGREE + 1 }>(k, span, u, d, out),
+            1 => poly.eval::<2>(k, span, u, d, out),
+            2 => poly.eval::<3>(k, span, u, d, out),
+            3 => poly.eval::<4>(k, span, u, d, out),
+            4 => poly.eval::<5>(k, span, u, d, out),
+            5 => poly.eval::<6>(k, span, u, d, out),
+            6 => poly.eval::<7>(k, span, u, d, out),
+            _ => poly.eval::<{ MAX_DEGREE + 1 }>(k, span, u, d, out),
         };
         if !done {
             basis_ders_cox_de_boor(self.degree, k, span, u, d, out);
@@ -548,8 +572,14 @@ mod tests {
             knots.extend(std::iter::repeat_n(end, p + 1));
             let k = KnotVector::try_new(p, knots).expect("valid knots");
             let n = k.num_basis();
-            for u in [at * end, t, k.knots()[p + gaps.len() / 2], end] {
+            let probes = [at * end, t, k.knots()[p + gaps.len() / 2], end];
+            // Before the tables exist find_span searches; after, it walks from the buckets.
+            let searched: Vec<usize> = probes.iter().map(|&u| k.find_span(u)).collect();
+            let mut scratch = [[0.0; MAX_DEGREE + 1]; 1];
+            k.basis_ders(p, k.knots()[p], 0, &mut scratch);
+            for (&u, &before) in probes.iter().zip(&searched) {
                 let span = k.find_span(u);
+                prop_assert_eq!(span, before, "u {}", u);
                 let c = k.clamp(u);
                 let expected = if c >= k.knots()[n] {
                     span // the domain end: checked by spans_cover_domain
