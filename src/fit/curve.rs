@@ -9,7 +9,7 @@
 use super::accel::Accelerator;
 use super::{Acceleration, ErrorStats, FitError, FitStatus, Fitter, IterationRecord, Tolerances};
 use crate::geom::{Aabb, Point3, Vec3};
-use crate::spline::{BSplineCurve, MAX_CURVE_DEGREE};
+use crate::spline::{BSplineCurve, NewtonOptions, MAX_CURVE_DEGREE};
 use web_time::Instant;
 
 /// Options of the geometric curve fitter. Defaults in brackets on each field.
@@ -209,11 +209,16 @@ impl CurveData {
         params: &mut [f64],
         newton_iter: usize,
     ) -> Vec<f64> {
+        // As for surfaces (patches::correct_parameters): a step of 1e-7 of the domain is far
+        // below any fitting tolerance.
+        let opts = NewtonOptions::default()
+            .with_max_iterations(newton_iter)
+            .with_param_tolerance(1e-7);
         self.points
             .iter()
             .zip(params.iter_mut())
             .map(|(&p, u)| {
-                let near = curve.closest_point_from(p, *u, newton_iter);
+                let near = curve.closest_point_from(p, *u, opts);
                 *u = near.u;
                 self.signed_distance(p, &near)
             })

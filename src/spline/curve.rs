@@ -5,6 +5,7 @@
 //! keeps evaluation, knot insertion and fitting one code path for both kinds.
 
 use super::knots::{KnotVector, MAX_DEGREE};
+use super::surface::NewtonOptions;
 use super::SplineError;
 use crate::geom::{Point3, Vec3};
 use glam::DVec4;
@@ -277,10 +278,14 @@ impl BSplineCurve {
     }
 
     /// The foot point of `p` on the curve by Newton's method on (C(u) − p)·C'(u) = 0, started at
-    /// `u0`. Each step is damped until the distance does not grow; the parameter is wrapped
-    /// (closed) or clamped (open) into the domain. Converged when a step moves the foot point
-    /// by less than 1e-12 of the curve's extent (|C'|·period) plus 1e-9 of the distance.
-    pub fn closest_point_from(&self, p: Point3, u0: f64, max_iter: usize) -> CurveNearest {
+    /// `u0`, for at most `opts.max_iterations` steps. Each step is damped until the distance
+    /// does not grow; the parameter is wrapped (closed) or clamped (open) into the domain.
+    /// Converged when a step is below `opts.param_tolerance` of the domain plus 1e-9 of the
+    /// distance (over |C'|). A fit, which re-projects every point each iteration, can stop at a
+    /// looser step than the default 1e-12: the distance is stationary at the foot point, so a
+    /// small parameter error changes it by a second-order amount.
+    pub fn closest_point_from(&self, p: Point3, u0: f64, opts: NewtonOptions) -> CurveNearest {
+        let max_iter = opts.max_iterations;
         let (a, b) = self.domain();
         let mut u = self.normalize_param(u0);
         let mut c = self.eval_derivs(u, 2);
@@ -296,7 +301,8 @@ impl BSplineCurve {
                 return self.nearest(u, &c, dist_sq, it, true);
             }
             let speed = g.sqrt();
-            let tol = 1e-12 * (b - a) + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
+            let tol = opts.param_tolerance * (b - a)
+                + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
             let mut du = (-f / denom).clamp(-0.25 * (b - a), 0.25 * (b - a));
             if du.abs() <= tol {
                 return self.nearest(u, &c, dist_sq, it, true);
@@ -332,7 +338,7 @@ impl BSplineCurve {
                 best = (u, d);
             }
         }
-        self.closest_point_from(p, best.0, 30)
+        self.closest_point_from(p, best.0, NewtonOptions::default().with_max_iterations(30))
     }
 
     /// Parameters spread over every non-empty knot span (span starts and interior samples),
