@@ -201,6 +201,10 @@ impl BSplineCurve {
             return a;
         }
         if self.closed {
+            if (a..b).contains(&u) {
+                // Already in the period (every Newton step but those crossing the seam).
+                return u;
+            }
             let t = a + (u - a).rem_euclid(b - a);
             if t >= b {
                 a
@@ -254,8 +258,13 @@ impl BSplineCurve {
         self.knots.basis_ders(span, u, d, &mut nd);
         let mut a = [Point3::ZERO; MAX_DERIV + 1];
         let mut w = [0.0; MAX_DERIV + 1];
+        let n = self.ctrl.len();
+        let mut idx = self.ctrl_index(span - p);
         for j in 0..=p {
-            let idx = self.ctrl_index(span - p + j);
+            if j > 0 {
+                // The next control point, wrapping for a closed curve (one division per call).
+                idx = if idx + 1 == n { 0 } else { idx + 1 };
+            }
             let wt = self.weights.as_ref().map_or(1.0, |w| w[idx]);
             for ((ak, wk), row) in a.iter_mut().zip(w.iter_mut()).zip(&nd).take(d + 1) {
                 *ak += row[j] * wt * self.ctrl[idx];
