@@ -121,7 +121,8 @@ impl SpanPolynomials {
         let mut ders = [[0.0; MAX_DEGREE + 1]; MAX_DEGREE + 1];
         for (i, entry) in (p..n).zip(table.chunks_exact_mut(stride)) {
             let h = knots[i + 1] - knots[i];
-            if h <= 0.0 {
+            // An empty span, or one so short that 1/h overflows, keeps to A2.3.
+            if h <= 0.0 || !(1.0 / h).is_finite() {
                 continue;
             }
             basis_ders_cox_de_boor(p, knots, i, knots[i], p, &mut ders);
