@@ -8,7 +8,9 @@
 //! was).
 
 use super::accel::Accelerator;
-use super::lsq_surface::{check_common, plane_surface, LsqSurfaceFitter, LsqSurfaceOptions};
+use super::lsq_surface::{
+    check_common, check_early_split_share, plane_surface, LsqSurfaceFitter, LsqSurfaceOptions,
+};
 use super::options::Acceleration;
 use super::parameterize::{check_points, parameterize, ParamOptions, Parameterization};
 use super::patches::{
@@ -182,12 +184,7 @@ impl GeometricSurfaceFitter {
                 });
             }
         }
-        if !(0.0..=1.0).contains(&opts.early_split_share) {
-            return Err(FitError::InvalidOption {
-                name: "early_split_share",
-                reason: format!("{} is outside 0..=1", opts.early_split_share),
-            });
-        }
+        check_early_split_share(opts.early_split_share)?;
         check_points(points, opts.degree + 1)?;
         let mut param = parameterize(points, &opts.param)?;
         let mut surface = plane_surface(&param, opts.degree, opts.control)?;

@@ -164,12 +164,7 @@ impl LsqSurfaceOptions {
                 });
             }
         }
-        if !(0.0..=1.0).contains(&self.early_split_share) {
-            return Err(FitError::InvalidOption {
-                name: "early_split_share",
-                reason: format!("{} is outside 0..=1", self.early_split_share),
-            });
-        }
+        check_early_split_share(self.early_split_share)?;
         if self.solves_per_knots == 0 {
             return Err(FitError::InvalidOption {
                 name: "solves_per_knots",
@@ -178,6 +173,17 @@ impl LsqSurfaceOptions {
         }
         Ok(())
     }
+}
+
+/// The failing-patch share of both surface fitters' early split, a fraction in 0..=1.
+pub(crate) fn check_early_split_share(share: f64) -> Result<(), FitError> {
+    if (0.0..=1.0).contains(&share) {
+        return Ok(());
+    }
+    Err(FitError::InvalidOption {
+        name: "early_split_share",
+        reason: format!("{share} is outside 0..=1"),
+    })
 }
 
 /// Range checks of degree, control counts and tolerance shared by the surface fitters.
