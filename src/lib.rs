@@ -22,6 +22,9 @@
 //! The core is plain Rust with f64 maths and is tested natively with `cargo test`; the renderer
 //! and the wasm bindings sit behind the `wasm32` target.
 
+#[macro_use]
+mod macros;
+
 pub mod cloud;
 pub mod export;
 pub mod fit;

@@ -1,10 +1,31 @@
+use crate::mesh::{SimplifyError, TopologyError};
 use thiserror::Error;
 
-/// Why a fit could not be set up or continued.
+/// Why a fit could not be set up or continued. Variants about the input or the options carry
+/// the offending index or option name; [`FitError::Internal`] marks a failed consistency check
+/// (a bug, not bad input).
+///
+/// ```
+/// use geofit::fit::{FitError, FitSpec, Scheme};
+///
+/// let spec = FitSpec::new(Scheme::Loop).with_tol_max(Some(-1.0));
+/// match spec.validate() {
+///     Err(FitError::InvalidOption { name, .. }) => assert_eq!(name, "tolMax"),
+///     other => panic!("{other:?}"),
+/// }
+/// ```
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum FitError {
     /// There are too few data points for the requested surface or curve.
+    ///
+    /// ```
+    /// use geofit::fit::{CurveFitOptions, CurveFitter, FitError};
+    /// use geofit::geom::Point3;
+    /// let two = [Point3::ZERO, Point3::X];
+    /// let err = CurveFitter::try_new(&two, CurveFitOptions::default()).err();
+    /// assert!(matches!(err, Some(FitError::TooFewPoints { found: 2, .. })));
+    /// ```
     #[error("too few data points: {found}, need at least {needed}")]
     TooFewPoints {
         /// Points given.
@@ -13,21 +34,70 @@ pub enum FitError {
         needed: usize,
     },
     /// An option is out of its valid range.
-    #[error("invalid option {name}: {reason}")]
+    ///
+    /// ```
+    /// use geofit::fit::{FitError, SubdivFitOptions};
+    /// let err = SubdivFitOptions::default().with_max_iter(0).validate();
+    /// assert!(matches!(err, Err(FitError::InvalidOption { name: "maxIter", .. })));
+    /// ```
+    #[error("option {name}: {reason}")]
     InvalidOption {
-        /// Option name as the user spells it.
+        /// The option, as [`crate::fit::FitSpec`] names it (camelCase).
         name: &'static str,
         /// What is wrong with it.
         reason: String,
     },
-    /// The control mesh cannot be used by the scheme or the refinement (wrong face arity,
-    /// non-manifold or inconsistently oriented edges, ...).
-    #[error("invalid control mesh: {reason}")]
-    ControlMesh {
-        /// What is wrong, with the offending face or vertex.
-        reason: String,
+    /// An option was given that the chosen scheme (and method) does not use.
+    ///
+    /// ```
+    /// use geofit::fit::{FitError, FitSpec, Scheme};
+    /// let err = FitSpec::new(Scheme::Loop).with_degree(Some(3)).validate();
+    /// assert!(matches!(err, Err(FitError::NotApplicable { name: "degree", .. })));
+    /// ```
+    #[error("option {name} does not apply to scheme {scheme}{}", method.map_or(String::new(), |m| format!(" with method {m}")))]
+    NotApplicable {
+        /// The option.
+        name: &'static str,
+        /// The scheme chosen.
+        scheme: crate::fit::Scheme,
+        /// The method chosen, when the option depends on it.
+        method: Option<crate::fit::Method>,
+    },
+    /// The data has no faces to start a subdivision fit from, and no control mesh was given.
+    ///
+    /// ```
+    /// use geofit::fit::{initial_control, FitError};
+    /// use geofit::geom::Point3;
+    /// use geofit::mesh::PolyMesh;
+    /// let cloud = PolyMesh::try_new(vec![Point3::ZERO; 3], Vec::<[u32; 3]>::new()).unwrap();
+    /// assert_eq!(initial_control(&cloud, None), Err(FitError::NoFaces));
+    /// ```
+    #[error("invalid control mesh: the data has no faces; reconstruct a mesh from the points or give a control mesh")]
+    NoFaces,
+    /// The control mesh (given, or made by simplification) has no faces.
+    #[error("invalid control mesh: the control mesh has no faces")]
+    EmptyControlMesh,
+    /// The control mesh is not a valid oriented manifold for subdivision.
+    #[error("invalid control mesh: {0}")]
+    ControlMesh(#[from] TopologyError),
+    /// QEM simplification could not make the initial control mesh.
+    #[error("invalid control mesh: simplification: {0}")]
+    Simplify(#[from] SimplifyError),
+    /// The limit surface has no finite point near a data point (a degenerate control mesh).
+    #[error("the limit surface has no finite point near data point {point}")]
+    NoSurfaceNear {
+        /// The data point.
+        point: usize,
     },
     /// A data point has a NaN or infinite coordinate.
+    ///
+    /// ```
+    /// use geofit::fit::{CurveFitOptions, CurveFitter, FitError};
+    /// use geofit::geom::Point3;
+    /// let pts = [Point3::ZERO, Point3::X, Point3::NAN, Point3::Y, Point3::Z];
+    /// let err = CurveFitter::try_new(&pts, CurveFitOptions::default()).err();
+    /// assert_eq!(err, Some(FitError::NonFinitePoint { index: 2 }));
+    /// ```
     #[error("data point {index} has a non-finite coordinate")]
     NonFinitePoint {
         /// Index of the point in the data.
@@ -51,7 +121,7 @@ pub enum FitError {
         /// The control point without support.
         index: usize,
     },
-    /// The subdivision library rejected the control mesh.
+    /// The subdivision library rejected the control mesh or a refinement of it.
     #[error(transparent)]
     Subdiv(#[from] crate::subdiv::SubdivError),
     /// Projecting the points to parameterise them gives no usable parameter domain.
@@ -80,5 +150,11 @@ pub enum FitError {
     Solver {
         /// The solver's message.
         reason: String,
+    },
+    /// An internal consistency check failed: a bug, not a problem of the input.
+    #[error("internal error: {what}")]
+    Internal {
+        /// The check that failed.
+        what: String,
     },
 }

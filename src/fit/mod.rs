@@ -1,48 +1,52 @@
-//! Fitting engines. Every engine (subdivision surfaces, B-spline surfaces and curves) is driven
-//! the same way through [`Fitter`]: build it from data and options, call [`Fitter::step`] for one
-//! iteration (the page animates this) or [`Fitter::run`] to the end, and read statistics and
-//! per-point errors at any time.
+//! Fitting engines. Every engine — subdivision surfaces, B-spline surfaces (geometric or least
+//! squares) and B-spline curves (geometric or knot placement) — is built from a [`FitSpec`] and
+//! driven the same way through [`Fitter`]: [`Fitter::step`] for one iteration (the page animates
+//! this) or [`Fitter::run`] to the end; statistics, per-point errors and the current shapes can
+//! be read at any time, and [`FitReport::of`] summarises any of them.
+//!
+//! | module | what it holds |
+//! |---|---|
+//! | `spec` | [`FitSpec`]: what to fit and how, with every default and its validation |
+//! | `subdiv` | [`SubdivFitter`]: Loop, Catmull–Clark and Doo–Sabin limit surfaces (SPEC §1) |
+//! | `surface` | [`GeometricSurfaceFitter`], [`LsqSurfaceFitter`]: one B-spline surface (SPEC §1, §2) |
+//! | `curve` | [`CurveFitter`], [`KnotPlacementFitter`]: B-spline curves (SPEC §1.9, §3) |
+//! | `log` | [`FitLog`]: the history and status bookkeeping every engine shares |
+//! | `report` | [`FitReport`]: the machine-readable summary of any fit |
 
 mod accel;
-pub mod bspline_surface;
-mod build;
-pub mod closest;
-pub mod curve;
-mod curve_lsq;
+mod curve;
 mod error;
-mod frozen;
-pub mod knot_placement;
-pub mod lsq_surface;
-mod normal_system;
-pub mod options;
+mod log;
 mod parallel;
-pub mod parameterize;
-pub mod patches;
-pub mod refine;
-pub mod refine_ds;
-pub mod refine_quad;
-pub mod report;
-mod scheme;
+mod report;
+mod spec;
 mod stats;
-pub mod subdiv;
+mod subdiv;
+mod surface;
 
-pub use bspline_surface::{GeometricSurfaceFitter, GeometricSurfaceOptions};
-pub use build::{
-    build_subdiv_fitter, default_initial_count, initial_control, ReconstructionReport, SubdivSetup,
+pub use accel::Acceleration;
+pub use curve::{
+    least_squares_curve, CurveFitOptions, CurveFitter, KnotFeature, KnotPlacementFitter,
+    KnotPlacementOptions,
 };
-pub use closest::FootPoint;
-pub use curve::{CurveFitOptions, CurveFitter};
-pub use curve_lsq::least_squares_curve;
 pub use error::FitError;
-pub use knot_placement::{KnotPlacementFitter, KnotPlacementOptions};
-pub use lsq_surface::{LsqSurfaceFitter, LsqSurfaceOptions};
-pub use options::{Acceleration, SubdivFitOptions, Weighting};
-pub use parameterize::{FoldPolicy, ParamOptions, Parameterization};
-pub use patches::TolMode;
+pub use log::FitLog;
 pub use report::{within_tolerance_pct, FitReport};
-pub use scheme::surface_of;
+pub use spec::{Cloud, FitData, FitSpec, Method, OptionInfo, Scheme, OPTION_TABLE};
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
-pub use subdiv::{ControlSurface, SubdivFitter};
+pub use subdiv::{
+    default_initial_count, initial_control, surface_of, ControlSurface, ReconstructionReport,
+    SubdivFitOptions, SubdivFitter, Weighting,
+};
+pub use surface::{
+    energies, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
+    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions,
+    Parameterization, SurfaceGrid, TolMode,
+};
+
+use crate::geom::Point3;
+use crate::mesh::PolyMesh;
+use crate::spline::{BSplineCurve, BSplineSurface};
 
 /// What one call of [`Fitter::step`] left the fit in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -52,13 +56,37 @@ pub enum FitStatus {
     Running,
     /// Every tolerance given is met.
     Converged,
-    /// The iteration cap was reached first.
+    /// The iteration cap was reached first (or nothing could be refined any more).
     MaxIterations,
 }
 
-/// The interface every fitting engine offers.
+/// A drawable shape of a fit: its control net or its fitted surface or curve.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// Faces (drawn shaded; their edges drawn as lines).
+    Mesh(PolyMesh),
+    /// Points joined in order, back to the first when closed.
+    Polyline {
+        /// The vertices.
+        points: Vec<Point3>,
+        /// Whether the last joins the first.
+        closed: bool,
+    },
+}
+
+/// The fitted spline of a fit that has one, for CAD export.
+#[derive(Clone, Copy, Debug)]
+pub enum Spline<'a> {
+    /// A tensor-product B-spline / NURBS surface.
+    Surface(&'a BSplineSurface),
+    /// A B-spline / NURBS curve.
+    Curve(&'a BSplineCurve),
+}
+
+/// The interface every fitting engine offers: iterate, and read where the fit stands.
 pub trait Fitter {
-    /// Runs one iteration (foot points, error vectors, control-point moves; refinement when due).
+    /// Runs one iteration (foot points, error vectors, control-point moves; refinement when
+    /// due). Once the fit has stopped it changes nothing and returns the status again.
     fn step(&mut self) -> Result<FitStatus, FitError>;
 
     /// Iterates until converged or out of iterations.
@@ -71,13 +99,74 @@ pub trait Fitter {
         }
     }
 
-    /// One record per iteration so far; the last is the current state.
-    fn history(&self) -> &[IterationRecord];
+    /// The scheme this engine fits.
+    fn scheme(&self) -> Scheme;
 
-    /// Signed distance of every data point to the current surface, in model units (positive on
-    /// the side the surface normal points to), in data order.
+    /// The method it fits with.
+    fn method(&self) -> Method;
+
+    /// History, status, set-up time and intake of the fit.
+    fn log(&self) -> &FitLog;
+
+    /// The log, for builders that add what they did before the engine existed (reading,
+    /// meshing, simplification) to its set-up time and intake.
+    fn log_mut(&mut self) -> &mut FitLog;
+
+    /// Where the fit stands after the last step.
+    fn status(&self) -> FitStatus {
+        self.log().status()
+    }
+
+    /// One record per iteration so far; the last is the current state.
+    fn history(&self) -> &[IterationRecord] {
+        self.log().history()
+    }
+
+    /// The tolerances the fit stops at (% of the bounding-box diagonal).
+    fn tolerances(&self) -> Tolerances;
+
+    /// The data points, in the order of [`Fitter::point_errors`].
+    fn data(&self) -> &[Point3];
+
+    /// Bounding-box diagonal of the data: what the `_pct` figures are relative to.
+    fn diagonal(&self) -> f64;
+
+    /// Signed distance of every data point to the current surface or curve, in model units
+    /// (positive on the side the surface normal points to), in data order.
     fn point_errors(&self) -> &[f64];
 
-    /// Error statistics of the current surface.
+    /// Error statistics of the current surface or curve.
     fn stats(&self) -> ErrorStats;
+
+    /// The point of the surface or curve each data point is measured to, in data order.
+    fn foot_points(&self) -> Vec<Point3>;
+
+    /// Number of control points now.
+    fn num_control_points(&self) -> usize;
+
+    /// The control net: the control mesh, the B-spline control grid, or a curve's polygon.
+    fn control_shape(&self) -> Shape;
+
+    /// The fitted shape: a surface tessellated with `resolution` segments per patch (knot
+    /// span) edge, or a curve sampled with `4 · resolution` segments per control point.
+    /// `resolution` is clamped to 1..=64.
+    fn limit_shape(&self, resolution: usize) -> Shape;
+
+    /// Iso-parameter lines at the knots of a B-spline surface as segment end points (two per
+    /// segment, `resolution` segments per knot span); none for other shapes.
+    fn iso_lines(&self, resolution: usize) -> Vec<Point3> {
+        let _ = resolution;
+        Vec::new()
+    }
+
+    /// The fitted spline, for IGES and STEP; subdivision surfaces have none.
+    fn spline(&self) -> Option<Spline<'_>> {
+        None
+    }
+
+    /// What only this engine reports (control grid, fold-overs, features), as JSON fields
+    /// that [`FitReport`] lists under `details`.
+    fn details(&self) -> serde_json::Map<String, serde_json::Value> {
+        serde_json::Map::new()
+    }
 }

@@ -1,16 +1,16 @@
-//! The machine-readable summary of a fit (`geofit fit --json`).
+//! The machine-readable summary of a fit (`geofit fit --json`, `Fitter.reportJson()`): one
+//! builder, [`FitReport::of`], for every engine.
 
-use super::build::ReconstructionReport;
-use super::subdiv::{ControlSurface, SubdivFitter};
-use super::{FitStatus, Fitter, IterationRecord};
+use super::{FitStatus, Fitter, IterationRecord, ReconstructionReport};
 use serde::Serialize;
 
-/// What `geofit fit --json REPORT.json` writes: the set-up, the final errors, the times and one
-/// entry per iteration.
+/// The set-up, the final errors, the times and one entry per iteration of a fit.
 #[derive(Clone, Debug, Serialize)]
 pub struct FitReport {
-    /// Scheme name (`loop`, `catmull-clark`, `doo-sabin`, ...).
+    /// Scheme name (`loop`, `catmull-clark`, `doo-sabin`, `bspline-surface`, ...).
     pub scheme: String,
+    /// Method name (`geometric`, `least-squares`, `knots`).
+    pub method: String,
     /// Number of data points.
     pub points: usize,
     /// Control points at the start.
@@ -27,53 +27,56 @@ pub struct FitReport {
     pub e_rms_pct: f64,
     /// Whether every tolerance was met.
     pub converged: bool,
+    /// How the fit ended (or `running`).
+    pub status: FitStatus,
     /// Share of the data points within the E_max tolerance of the surface, % (`None` without
     /// an E_max tolerance): the figure that matters for noisy scans, whose E_max is noise.
     pub within_tolerance_pct: Option<f64>,
     /// What was reconstructed from bare points before simplification (absent for meshes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reconstruction: Option<ReconstructionReport>,
-    /// Seconds before the first iteration (initial control mesh, surface set-up, first foot
-    /// points), including what the caller adds (reading, simplification).
+    /// Seconds before the first iteration (reading, meshing, simplification, the engine's
+    /// set-up and first foot points).
     pub precompute_s: f64,
     /// Seconds spent iterating.
     pub fit_s: f64,
     /// `precompute_s + fit_s`.
     pub total_s: f64,
+    /// What only this engine reports ([`Fitter::details`]).
+    pub details: serde_json::Map<String, serde_json::Value>,
     /// One record per iteration.
     pub history: Vec<IterationRecord>,
 }
 
 impl FitReport {
-    /// The report of `fitter` now; `extra_precompute_s` is set-up time spent outside the fitter
-    /// (e.g. simplification for the initial control mesh) and `fit_s` the iteration time.
-    pub fn of<S: ControlSurface>(
-        fitter: &SubdivFitter<S>,
-        extra_precompute_s: f64,
-        fit_s: f64,
-    ) -> FitReport {
+    /// The report of `fitter` now.
+    pub fn of(fitter: &dyn Fitter) -> FitReport {
+        let log = fitter.log();
         let stats = fitter.stats();
-        let precompute_s = extra_precompute_s + fitter.precompute_seconds();
+        let precompute_s = log.precompute_seconds();
+        let fit_s = log.fit_seconds();
         FitReport {
-            scheme: fitter.surface().scheme_name().to_string(),
+            scheme: fitter.scheme().to_string(),
+            method: fitter.method().to_string(),
             points: fitter.data().len(),
-            initial_control_points: fitter.initial_control_points(),
+            initial_control_points: log.initial_control_points(),
             final_control_points: fitter.num_control_points(),
-            iterations: fitter.history().len(),
+            iterations: log.iterations(),
             e_avg_pct: stats.e_avg_pct,
             e_max_pct: stats.e_max_pct,
             e_rms_pct: stats.e_rms_pct,
-            converged: fitter.status() == FitStatus::Converged,
+            converged: log.status() == FitStatus::Converged,
+            status: log.status(),
             within_tolerance_pct: fitter
-                .options()
-                .tolerances
+                .tolerances()
                 .max_pct
                 .map(|tol| within_tolerance_pct(fitter.point_errors(), fitter.diagonal(), tol)),
-            reconstruction: None,
+            reconstruction: log.reconstruction().cloned(),
             precompute_s,
             fit_s,
             total_s: precompute_s + fit_s,
-            history: fitter.history().to_vec(),
+            details: fitter.details(),
+            history: log.history().to_vec(),
         }
     }
 }

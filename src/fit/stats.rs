@@ -1,3 +1,4 @@
+use super::FitError;
 use serde::{Deserialize, Serialize};
 
 /// Stopping tolerances, each in % of the data's bounding-box diagonal. A fit stops when every
@@ -15,21 +16,53 @@ pub struct Tolerances {
 
 impl Default for Tolerances {
     fn default() -> Self {
-        Tolerances {
-            avg_pct: Some(0.01),
-            max_pct: Some(0.05),
-            rms_pct: None,
-        }
+        Tolerances::DEFAULT
     }
 }
 
 impl Tolerances {
-    /// The tolerances a user gave, or the defaults when none is given: giving one tolerance
+    /// The specification's tolerances (SPEC §1, the patent's Table 1): E_avg 0.01 %, E_max
+    /// 0.05 %.
+    pub const DEFAULT: Tolerances = Tolerances {
+        avg_pct: Some(0.01),
+        max_pct: Some(0.05),
+        rms_pct: None,
+    };
+
+    /// Only an E_max tolerance of `pct` %.
+    pub const fn max_only(pct: f64) -> Tolerances {
+        Tolerances {
+            avg_pct: None,
+            max_pct: Some(pct),
+            rms_pct: None,
+        }
+    }
+
+    /// Rejects negative or non-finite tolerances, naming the option (`tolAvg`, `tolMax`,
+    /// `tolRms`).
+    pub fn validate(&self) -> Result<(), FitError> {
+        for (name, v) in [
+            ("tolAvg", self.avg_pct),
+            ("tolMax", self.max_pct),
+            ("tolRms", self.rms_pct),
+        ] {
+            if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
+                return Err(FitError::InvalidOption {
+                    name,
+                    reason: format!("{v} is not a finite percentage >= 0"),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The tolerances a user gave, or `default` when none is given: giving one tolerance
     /// means only that one counts, so the defaults must not mix in.
-    pub fn given_or_default(
+    pub fn given_or(
         avg_pct: Option<f64>,
         max_pct: Option<f64>,
         rms_pct: Option<f64>,
+        default: Tolerances,
     ) -> Self {
         if avg_pct.is_some() || max_pct.is_some() || rms_pct.is_some() {
             Tolerances {
@@ -38,7 +71,7 @@ impl Tolerances {
                 rms_pct,
             }
         } else {
-            Tolerances::default()
+            default
         }
     }
 

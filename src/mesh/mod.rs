@@ -11,4 +11,4 @@ pub use error::MeshError;
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
 pub use simplify::{simplify, simplify_with, SimplifyError, SimplifyOptions};
-pub use validate::TopologyError;
+pub use validate::{check_oriented_edges, TopologyError};

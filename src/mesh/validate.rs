@@ -82,3 +82,23 @@ pub enum TopologyError {
         count: usize,
     },
 }
+
+/// Checks that `mesh` is a consistently oriented manifold with boundary as far as its edges
+/// tell: no face repeats a vertex, and no directed edge is used twice (so every edge has one or
+/// two faces, and two faces on an edge use it in opposite directions). Cheaper than building a
+/// [`crate::mesh::ControlMesh`]; local refinement checks its output with it.
+pub fn check_oriented_edges(mesh: &crate::mesh::PolyMesh) -> Result<(), TopologyError> {
+    let mut directed = std::collections::HashSet::new();
+    for (face, f) in mesh.faces().enumerate() {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            if a == b {
+                return Err(TopologyError::DegenerateFace { face, vertex: a });
+            }
+            if !directed.insert((a, b)) {
+                return Err(TopologyError::InconsistentOrientation { a, b });
+            }
+        }
+    }
+    Ok(())
+}

@@ -5,9 +5,8 @@
 //! keeps evaluation, knot insertion and fitting one code path for both kinds.
 
 use super::knots::{KnotVector, MAX_DEGREE};
-use super::surface::NewtonOptions;
 use super::SplineError;
-use crate::geom::{Point3, Vec3};
+use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3};
 use glam::DVec4;
 
 /// Highest derivative order [`BSplineCurve::eval_derivs`] returns.
@@ -24,23 +23,6 @@ pub struct BSplineCurve {
     ctrl: Vec<Point3>,
     weights: Option<Vec<f64>>,
     closed: bool,
-}
-
-/// The result of a closest-point query on a curve.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CurveNearest {
-    /// Parameter of the foot point.
-    pub u: f64,
-    /// The foot point C(u).
-    pub point: Point3,
-    /// Squared distance from the query point to the foot point.
-    pub dist_sq: f64,
-    /// The first derivative C'(u) at the foot point (it orients signed distances).
-    pub tangent: Vec3,
-    /// Newton iterations used.
-    pub iterations: usize,
-    /// Whether the Newton step fell below the parameter tolerance.
-    pub converged: bool,
 }
 
 /// The non-zero basis functions of a curve at one parameter: control point
@@ -286,60 +268,10 @@ impl BSplineCurve {
         c
     }
 
-    /// The foot point of `p` on the curve by Newton's method on (C(u) − p)·C'(u) = 0, started at
-    /// `u0`, for at most `opts.max_iterations` steps. Each step is damped until the distance
-    /// does not grow; the parameter is wrapped (closed) or clamped (open) into the domain.
-    /// Converged when a step is below `opts.param_tolerance` of the domain plus 1e-9 of the
-    /// distance (over |C'|). A fit, which re-projects every point each iteration, can stop at a
-    /// looser step than the default 1e-12: the distance is stationary at the foot point, so a
-    /// small parameter error changes it by a second-order amount.
-    pub fn closest_point_from(&self, p: Point3, u0: f64, opts: NewtonOptions) -> CurveNearest {
-        let max_iter = opts.max_iterations;
-        let (a, b) = self.domain();
-        let mut u = self.normalize_param(u0);
-        let mut c = self.eval_derivs(u, 2);
-        let mut dist_sq = (c[0] - p).length_squared();
-        for it in 0..max_iter {
-            let r = c[0] - p;
-            let f = r.dot(c[1]);
-            let g = c[1].length_squared();
-            let fp = g + r.dot(c[2]);
-            // Newton where the curve is locally convex towards p, Gauss–Newton elsewhere.
-            let denom = if fp > 1e-3 * g { fp } else { g };
-            if denom.is_nan() || denom <= 0.0 {
-                return self.nearest(u, &c, dist_sq, it, true);
-            }
-            let speed = g.sqrt();
-            let tol = opts.param_tolerance * (b - a)
-                + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
-            let mut du = (-f / denom).clamp(-0.25 * (b - a), 0.25 * (b - a));
-            if du.abs() <= tol {
-                return self.nearest(u, &c, dist_sq, it, true);
-            }
-            let mut accepted = false;
-            for _ in 0..8 {
-                let un = self.normalize_param(u + du);
-                let cn = self.eval_derivs(un, 2);
-                let dn = (cn[0] - p).length_squared();
-                if dn <= dist_sq {
-                    accepted = (un - u).abs() > tol;
-                    u = un;
-                    c = cn;
-                    dist_sq = dn;
-                    break;
-                }
-                du *= 0.5;
-            }
-            if !accepted {
-                return self.nearest(u, &c, dist_sq, it + 1, true);
-            }
-        }
-        self.nearest(u, &c, dist_sq, max_iter, false)
-    }
 
     /// The foot point of `p`, seeded from the best of `samples_per_span` samples in every knot
     /// span; use it when no good starting parameter is known.
-    pub fn closest_point(&self, p: Point3, samples_per_span: usize) -> CurveNearest {
+    pub fn closest_point(&self, p: Point3, samples_per_span: usize) -> Nearest<f64> {
         let mut best = (self.domain().0, f64::INFINITY);
         for u in self.sample_params(samples_per_span.max(1)) {
             let d = (self.eval(u) - p).length_squared();
@@ -347,7 +279,7 @@ impl BSplineCurve {
                 best = (u, d);
             }
         }
-        self.closest_point_from(p, best.0, NewtonOptions::default().with_max_iterations(30))
+        self.closest_point_from(p, best.0, &NewtonOptions::DEFAULT.with_max_iter(30))
     }
 
     /// Parameters spread over every non-empty knot span (span starts and interior samples),
@@ -377,13 +309,13 @@ impl BSplineCurve {
         dist_sq: f64,
         iterations: usize,
         converged: bool,
-    ) -> CurveNearest {
-        CurveNearest {
-            u,
+    ) -> Nearest<f64> {
+        Nearest {
+            param: u,
             point: c[0],
             dist_sq,
-            tangent: c[1],
-            iterations,
+            direction: c[1],
+            iterations: u32::try_from(iterations).unwrap_or(u32::MAX),
             converged,
         }
     }
@@ -608,6 +540,61 @@ fn check_points(ctrl: &[Point3], expected: usize) -> Result<(), SplineError> {
         return Err(SplineError::NonFiniteControlPoint { index });
     }
     Ok(())
+}
+
+/// The foot point of `p` on the curve by Newton's method on (C(u) − p)·C'(u) = 0, started at
+/// `u0`, for at most `max_iter` steps. Each step is damped until the distance
+/// does not grow; the parameter is wrapped (closed) or clamped (open) into the domain.
+/// Converged when a step is below `step_tol` of the domain plus 1e-9 of the
+/// distance (over |C'|). A fit, which re-projects every point each iteration, can stop at a
+/// looser step than the default 1e-12: the distance is stationary at the foot point, so a
+/// small parameter error changes it by a second-order amount.
+impl ClosestPoint for BSplineCurve {
+    type Param = f64;
+
+    fn closest_point_from(&self, p: Point3, u0: f64, opts: &NewtonOptions) -> Nearest<f64> {
+        let max_iter = opts.max_iter;
+        let (a, b) = self.domain();
+        let mut u = self.normalize_param(u0);
+        let mut c = self.eval_derivs(u, 2);
+        let mut dist_sq = (c[0] - p).length_squared();
+        for it in 0..max_iter {
+            let r = c[0] - p;
+            let f = r.dot(c[1]);
+            let g = c[1].length_squared();
+            let fp = g + r.dot(c[2]);
+            // Newton where the curve is locally convex towards p, Gauss–Newton elsewhere.
+            let denom = if fp > 1e-3 * g { fp } else { g };
+            if denom.is_nan() || denom <= 0.0 {
+                return self.nearest(u, &c, dist_sq, it, true);
+            }
+            let speed = g.sqrt();
+            let tol = opts.step_tol * (b - a)
+                + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
+            let mut du = (-f / denom).clamp(-0.25 * (b - a), 0.25 * (b - a));
+            if du.abs() <= tol {
+                return self.nearest(u, &c, dist_sq, it, true);
+            }
+            let mut accepted = false;
+            for _ in 0..8 {
+                let un = self.normalize_param(u + du);
+                let cn = self.eval_derivs(un, 2);
+                let dn = (cn[0] - p).length_squared();
+                if dn <= dist_sq {
+                    accepted = (un - u).abs() > tol;
+                    u = un;
+                    c = cn;
+                    dist_sq = dn;
+                    break;
+                }
+                du *= 0.5;
+            }
+            if !accepted {
+                return self.nearest(u, &c, dist_sq, it + 1, true);
+            }
+        }
+        self.nearest(u, &c, dist_sq, max_iter, false)
+    }
 }
 
 #[cfg(test)]

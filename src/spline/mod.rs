@@ -12,9 +12,7 @@ mod knots;
 mod surface;
 
 pub use chaikin::ChaikinCurve;
-pub use curve::{BSplineCurve, CurveBasis, CurveNearest, MAX_CURVE_DEGREE, MAX_DERIV};
+pub use curve::{BSplineCurve, CurveBasis, MAX_CURVE_DEGREE, MAX_DERIV};
 pub use error::SplineError;
 pub use knots::{KnotVector, MAX_DEGREE};
-pub use surface::{
-    BSplineSurface, NewtonOptions, SurfaceBasis, SurfaceDerivs, SurfaceNearest, MAX_SURFACE_DERIV,
-};
+pub use surface::{BSplineSurface, SurfaceBasis, SurfaceDerivs, MAX_SURFACE_DERIV};

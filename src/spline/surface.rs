@@ -7,7 +7,7 @@
 
 use super::knots::MAX_DEGREE;
 use super::{KnotVector, SplineError};
-use crate::geom::{Point3, Vec3};
+use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 
 /// Highest derivative order [`BSplineSurface::derivs`] computes.
 pub const MAX_SURFACE_DERIV: usize = 3;
@@ -39,59 +39,6 @@ pub struct SurfaceBasis {
     pub bu: [f64; MAX_DEGREE + 1],
     /// The q + 1 basis values along v.
     pub bv: [f64; MAX_DEGREE + 1],
-}
-
-/// Options of the Newton foot-point search ([`BSplineSurface::closest_point`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
-pub struct NewtonOptions {
-    /// Iteration cap. Default 20.
-    pub max_iterations: usize,
-    /// Converged when the parameter step is below this fraction of the domain size.
-    /// Default 1e-12.
-    pub param_tolerance: f64,
-}
-
-impl Default for NewtonOptions {
-    fn default() -> Self {
-        NewtonOptions {
-            max_iterations: 20,
-            param_tolerance: 1e-12,
-        }
-    }
-}
-
-impl NewtonOptions {
-    /// Sets the iteration cap.
-    pub fn with_max_iterations(mut self, n: usize) -> Self {
-        self.max_iterations = n;
-        self
-    }
-
-    /// Sets the convergence threshold on the parameter step (fraction of the domain size).
-    pub fn with_param_tolerance(mut self, tol: f64) -> Self {
-        self.param_tolerance = tol;
-        self
-    }
-}
-
-/// A foot point found by [`BSplineSurface::closest_point`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SurfaceNearest {
-    /// Parameter u of the foot point.
-    pub u: f64,
-    /// Parameter v of the foot point.
-    pub v: f64,
-    /// S(u, v).
-    pub point: Point3,
-    /// Squared distance from the query point to `point`.
-    pub dist_sq: f64,
-    /// Unit normal S_u × S_v at the foot point (zero where the surface is degenerate).
-    pub normal: Vec3,
-    /// Newton iterations used.
-    pub iterations: usize,
-    /// Whether the step fell under the tolerance (at an interior minimum or on the boundary).
-    pub converged: bool,
 }
 
 /// A clamped tensor-product B-spline surface, optionally rational (NURBS).
@@ -358,87 +305,6 @@ impl BSplineSurface {
         Ok(())
     }
 
-    /// The foot point of `p` on the surface: Newton's method on the gradient of ½|S − p|²,
-    /// starting at `(u0, v0)`, with the full Hessian where it is positive definite and the
-    /// Gauss–Newton matrix otherwise, steps clamped into the domain. Never returns NaN: a
-    /// non-finite query or seed falls back to the domain start.
-    pub fn closest_point(
-        &self,
-        p: Point3,
-        u0: f64,
-        v0: f64,
-        opts: NewtonOptions,
-    ) -> SurfaceNearest {
-        let (du_dom, dv_dom) = self.domain();
-        let mut u = self.knots_u.clamp(u0);
-        let mut v = self.knots_v.clamp(v0);
-        let scale = (du_dom.1 - du_dom.0).max(dv_dom.1 - dv_dom.0);
-        let mut iterations = 0;
-        let mut converged = false;
-        let mut current = self.derivs(u, v, 2);
-        let mut dist_sq = (current.point() - p).length_squared();
-        while iterations < opts.max_iterations {
-            iterations += 1;
-            let steps = newton_steps(&current, p);
-            if steps.iter().all(Option::is_none) {
-                converged = true;
-                break;
-            }
-            // A step under the tolerance is the remaining parameter error (Newton converges
-            // quadratically): stop here without evaluating the surface once more.
-            let tiny_step =
-                |st: &(f64, f64)| st.0.abs().max(st.1.abs()) <= opts.param_tolerance * scale;
-            if steps.iter().flatten().next().is_some_and(tiny_step) {
-                converged = true;
-                break;
-            }
-            // Backtracking on the Newton step, then on the Gauss–Newton step: halve until the
-            // distance does not grow (a few ulps of slack: near the minimum rounding hides the
-            // true decrease).
-            let mut accepted = None;
-            'search: for (su, sv) in steps.into_iter().flatten() {
-                // A tiny full step is taken as it is: there the distance no longer resolves
-                // the decrease, and Newton converges quadratically.
-                let tiny = su.abs().max(sv.abs()) <= 1e-6 * scale;
-                let mut t = 1.0;
-                for _ in 0..12 {
-                    let nu = self.knots_u.clamp(u + t * su);
-                    let nv = self.knots_v.clamp(v + t * sv);
-                    let d = self.derivs(nu, nv, 2);
-                    let dsq = (d.point() - p).length_squared();
-                    if dsq <= dist_sq * (1.0 + 8.0 * f64::EPSILON) || (tiny && t == 1.0) {
-                        accepted = Some((nu, nv, d, dsq));
-                        break 'search;
-                    }
-                    t *= 0.5;
-                }
-            }
-            let Some((nu, nv, d, dsq)) = accepted else {
-                converged = true;
-                break;
-            };
-            let moved = (nu - u).abs().max((nv - v).abs());
-            (u, v, current, dist_sq) = (nu, nv, d, dsq);
-            if moved <= opts.param_tolerance * scale {
-                converged = true;
-                break;
-            }
-        }
-        let point = current.point();
-        let dist_sq = if p.is_finite() { dist_sq } else { f64::MAX };
-        let normal = current.skl[1][0]
-            .cross(current.skl[0][1])
-            .normalize_or_zero();
-        SurfaceNearest {
-            u,
-            v,
-            point,
-            dist_sq,
-            normal,
-            iterations,
-            converged,
-        }
-    }
 }
 
 /// Candidate steps (Δu, Δv) for min ½|S − p|²: the Newton step where the Hessian is positive
@@ -553,6 +419,90 @@ fn combine<G: Fn(usize) -> usize>(
             p1 * alpha + p0 * (1.0 - alpha),
             w1 * alpha + w0 * (1.0 - alpha),
         )
+    }
+}
+
+/// Foot points by Newton's method on the gradient of ½|S − p|², with the full Hessian where it
+/// is positive definite and the Gauss–Newton matrix otherwise, steps clamped into the domain.
+/// `step_tol` is a fraction of the larger side of the parameter domain. Never returns NaN: a
+/// non-finite query or seed falls back to the domain start.
+impl ClosestPoint for BSplineSurface {
+    type Param = [f64; 2];
+
+    fn closest_point_from(
+        &self,
+        p: Point3,
+        [u0, v0]: [f64; 2],
+        opts: &NewtonOptions,
+    ) -> Nearest<[f64; 2]> {
+        let (du_dom, dv_dom) = self.domain();
+        let mut u = self.knots_u.clamp(u0);
+        let mut v = self.knots_v.clamp(v0);
+        let scale = (du_dom.1 - du_dom.0).max(dv_dom.1 - dv_dom.0);
+        let mut iterations = 0u32;
+        let mut converged = false;
+        let mut current = self.derivs(u, v, 2);
+        let mut dist_sq = (current.point() - p).length_squared();
+        while (iterations as usize) < opts.max_iter {
+            iterations += 1;
+            let steps = newton_steps(&current, p);
+            if steps.iter().all(Option::is_none) {
+                converged = true;
+                break;
+            }
+            // A step under the tolerance is the remaining parameter error (Newton converges
+            // quadratically): stop here without evaluating the surface once more.
+            let tiny_step =
+                |st: &(f64, f64)| st.0.abs().max(st.1.abs()) <= opts.step_tol * scale;
+            if steps.iter().flatten().next().is_some_and(tiny_step) {
+                converged = true;
+                break;
+            }
+            // Backtracking on the Newton step, then on the Gauss–Newton step: halve until the
+            // distance does not grow (a few ulps of slack: near the minimum rounding hides the
+            // true decrease).
+            let mut accepted = None;
+            'search: for (su, sv) in steps.into_iter().flatten() {
+                // A tiny full step is taken as it is: there the distance no longer resolves
+                // the decrease, and Newton converges quadratically.
+                let tiny = su.abs().max(sv.abs()) <= 1e-6 * scale;
+                let mut t = 1.0;
+                for _ in 0..12 {
+                    let nu = self.knots_u.clamp(u + t * su);
+                    let nv = self.knots_v.clamp(v + t * sv);
+                    let d = self.derivs(nu, nv, 2);
+                    let dsq = (d.point() - p).length_squared();
+                    if dsq <= dist_sq * (1.0 + 8.0 * f64::EPSILON) || (tiny && t == 1.0) {
+                        accepted = Some((nu, nv, d, dsq));
+                        break 'search;
+                    }
+                    t *= 0.5;
+                }
+            }
+            let Some((nu, nv, d, dsq)) = accepted else {
+                converged = true;
+                break;
+            };
+            let moved = (nu - u).abs().max((nv - v).abs());
+            (u, v, current, dist_sq) = (nu, nv, d, dsq);
+            if moved <= opts.step_tol * scale {
+                converged = true;
+                break;
+            }
+        }
+        let point = current.point();
+        let dist_sq = if p.is_finite() { dist_sq } else { f64::MAX };
+        let normal = current.skl[1][0]
+            .cross(current.skl[0][1])
+            .normalize_or_zero();
+        Nearest {
+            param: [u, v],
+            point,
+            dist_sq,
+            direction: normal,
+            iterations,
+            converged,
+        }
     }
 }
 

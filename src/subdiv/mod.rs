@@ -8,16 +8,22 @@
 use crate::geom::{Point3, Vec3};
 use crate::mesh::{ControlMesh, MeshError, PolyMesh, TopologyError};
 
+pub mod adaptive;
 mod basis;
 mod doo_sabin;
+mod nearest;
 mod patch;
 mod refine;
+mod sites;
+mod step;
 mod surface;
+mod tessellate;
 mod topo;
 mod walk;
 
 pub use refine::{limit_positions, quadrangulate, refine, refine_levels};
-pub use surface::{SubdivSurface, Tessellation};
+pub use surface::SubdivSurface;
+pub use tessellate::{tessellate, Tessellation};
 
 /// Why a subdivision surface could not be built or refined.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -60,6 +66,26 @@ pub enum SubdivError {
     Unevaluable {
         /// The patch.
         patch: usize,
+    },
+    /// A face-flag array of local refinement does not have one flag per face.
+    #[error("{flags} face flags for {faces} faces")]
+    FlagCount {
+        /// Flags given.
+        flags: usize,
+        /// Faces of the mesh.
+        faces: usize,
+    },
+    /// Refinement would number vertices beyond the `u32` range.
+    #[error("{count} control points exceed the u32 index range")]
+    TooManyPoints {
+        /// The vertex count that did not fit.
+        count: usize,
+    },
+    /// An internal consistency check failed (a bug, not bad input): the message says which.
+    #[error("internal error: {what}")]
+    Internal {
+        /// The check that failed.
+        what: String,
     },
     /// The operation is not available for this scheme.
     #[error("{what} is not implemented")]

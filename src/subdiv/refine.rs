@@ -1,7 +1,6 @@
 //! Refinement of whole control meshes: one step of a scheme, several steps, and the conversion
 //! of any polygon mesh into quads for the quad schemes.
 
-use super::surface::topo_of;
 use super::topo::Topo;
 use super::{Scheme, SubdivError};
 use crate::geom::Point3;
@@ -21,10 +20,10 @@ pub fn refine(scheme: Scheme, mesh: &ControlMesh) -> Result<ControlMesh, SubdivE
             });
         }
     }
-    let topo = topo_of(mesh);
+    let topo = Topo::of_control_mesh(mesh);
     let refined = match scheme {
         Scheme::DooSabin => super::doo_sabin::refine_control(&topo),
-        _ => topo.refine(scheme),
+        _ => super::step::refine_step(&topo, scheme),
     };
     let old = mesh.positions();
     let positions = refined
@@ -57,7 +56,7 @@ pub fn refine_levels(
 /// vertex face (kept by every step; at boundaries and creases the vertex face of the mesh with
 /// its ghost ring, see [`refine`]).
 pub fn limit_positions(scheme: Scheme, mesh: &ControlMesh) -> Result<Vec<Point3>, SubdivError> {
-    let topo = topo_of(mesh);
+    let topo = Topo::of_control_mesh(mesh);
     let p = mesh.positions();
     let stencils: Vec<_> = match scheme {
         Scheme::DooSabin => super::doo_sabin::vertex_limits(&topo)

@@ -1,9 +1,10 @@
 //! [`SubdivSurface`]: the limit surface of a control mesh under one scheme, with everything
 //! topological precomputed so evaluation after moving control points is only weighted sums.
 
-use super::doo_sabin::{extend, limits_of, Extended};
+use super::doo_sabin::limits_of;
+use super::sites::DooSabinSites;
 use super::patch::{neighbourhood, vertex_neighbourhood, Graph, Kind};
-use super::topo::{EdgeTag, Stencil, Topo, NO};
+use super::topo::{Stencil, Topo};
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::{ControlMesh, NONE};
@@ -51,78 +52,6 @@ fn primal_sites(mesh: &ControlMesh) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// Doo–Sabin's patches: one per corner of the extended mesh (control mesh with its ghost ring)
-/// at a vertex that is not a ghost copy, with what walking across patch edges needs.
-pub(crate) struct DooSabinSites {
-    /// The extended mesh.
-    pub ext: Extended,
-    /// (extended face, extended vertex) of every patch.
-    pub sites: Vec<(u32, u32)>,
-    /// Patch of every corner of the extended mesh (`NO` at ghost copies).
-    pub corner_patch: Vec<u32>,
-}
-
-impl DooSabinSites {
-    fn new(topo: &Topo) -> DooSabinSites {
-        let ext = extend(topo);
-        let t = &ext.topo;
-        let mut sites = Vec::new();
-        let mut corner_patch = vec![NO; t.face_verts.len()];
-        for f in 0..t.num_faces() as u32 {
-            let s = t.face_starts[f as usize] as usize;
-            for (i, &v) in t.face(f).iter().enumerate() {
-                if !ext.ghost[v as usize] {
-                    corner_patch[s + i] = sites.len() as u32;
-                    sites.push((f, v));
-                }
-            }
-        }
-        DooSabinSites {
-            ext,
-            sites,
-            corner_patch,
-        }
-    }
-
-    /// (control face, control vertex) of every patch: a ghost face reports the control face on
-    /// whose cut edge it sits.
-    fn control_sites(&self) -> Vec<(u32, u32)> {
-        let e = &self.ext;
-        self.sites
-            .iter()
-            .map(|&(f, v)| {
-                let face = if (f as usize) < e.real_faces {
-                    f
-                } else {
-                    e.ghost_of[f as usize - e.real_faces]
-                };
-                (face, e.owner[v as usize])
-            })
-            .collect()
-    }
-}
-
-/// Builds the edge-tagged topology of a control mesh.
-pub(crate) fn topo_of(mesh: &ControlMesh) -> Topo {
-    let mut starts = vec![0u32];
-    let mut verts = Vec::new();
-    for f in 0..mesh.num_faces() as u32 {
-        verts.extend(mesh.face_vertices(f));
-        starts.push(verts.len() as u32);
-    }
-    Topo::new(mesh.num_vertices(), starts, verts, |a, b| {
-        let h = mesh
-            .find_half_edge(a, b)
-            .or_else(|| mesh.find_half_edge(b, a));
-        match h {
-            Some(h) => EdgeTag {
-                sharp: mesh.is_sharp(h),
-                open: mesh.is_boundary_edge(h),
-            },
-            None => EdgeTag::default(),
-        }
-    })
-}
 
 impl SubdivSurface {
     /// The limit surface of `mesh` under `scheme` (Loop needs triangles, Catmull–Clark quads).
@@ -226,7 +155,7 @@ impl SubdivSurface {
                 });
             }
         }
-        let topo = topo_of(&mesh);
+        let topo = Topo::of_control_mesh(&mesh);
         let mut patches = Vec::with_capacity(mesh.num_faces());
         let mut ctrl = Vec::new();
         let doo_sabin = (scheme == Scheme::DooSabin).then(|| Box::new(DooSabinSites::new(&topo)));
@@ -407,48 +336,6 @@ impl SubdivSurface {
         let clean = |x: f64| if x.is_finite() { x } else { 0.0 };
         Some((p, clean(at.u), clean(at.v)))
     }
-
-    /// Samples every patch on a regular grid with `segments` intervals per edge: positions,
-    /// normals, triangles and the parameter of each sample, for display and for seeding
-    /// closest-point searches.
-    pub fn tessellate(&self, segments: usize) -> Tessellation {
-        let n = segments.max(1);
-        let mut t = Tessellation::default();
-        for patch in 0..self.patches.len() as u32 {
-            let base = t.positions.len() as u32;
-            let mut grid = Vec::new();
-            for j in 0..=n {
-                for i in 0..=n {
-                    let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
-                    if self.scheme == Scheme::Loop && i + j > n {
-                        continue;
-                    }
-                    grid.push((i, j));
-                    let e = self.eval(SurfaceParam { patch, u, v });
-                    t.positions.push(e.point);
-                    t.normals.push(e.du.cross(e.dv).normalize_or_zero());
-                    t.params.push(SurfaceParam { patch, u, v });
-                }
-            }
-            let id = |i: usize, j: usize| {
-                grid.iter()
-                    .position(|&g| g == (i, j))
-                    .map(|p| base + p as u32)
-            };
-            for j in 0..n {
-                for i in 0..n {
-                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                    if let (Some(a), Some(b), Some(d)) = (a, b, d) {
-                        t.triangles.push([a, b, d]);
-                        if let Some(c) = c {
-                            t.triangles.push([b, c, d]);
-                        }
-                    }
-                }
-            }
-        }
-        t
-    }
 }
 
 /// Parameters of corner `i` of a patch.
@@ -460,19 +347,6 @@ fn corner_uv(scheme: Scheme, i: usize) -> (f64, f64) {
         (_, 2) => (1.0, 1.0),
         _ => (0.0, 1.0),
     }
-}
-
-/// A sampled limit surface.
-#[derive(Clone, Debug, Default)]
-pub struct Tessellation {
-    /// Sample positions.
-    pub positions: Vec<Point3>,
-    /// Unit normals at the samples.
-    pub normals: Vec<Vec3>,
-    /// Triangles over the samples (counter-clockwise like the control faces).
-    pub triangles: Vec<[u32; 3]>,
-    /// Patch and parameters of each sample.
-    pub params: Vec<SurfaceParam>,
 }
 
 impl LimitSurface for SubdivSurface {

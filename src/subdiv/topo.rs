@@ -7,6 +7,7 @@
 //! tag, and points whose rule would need faces beyond the rim are left uncomputed.
 
 use super::Scheme;
+use crate::mesh::ControlMesh;
 use std::collections::HashMap;
 
 /// Missing face or point.
@@ -205,18 +206,11 @@ impl Topo {
         }
     }
 
-    /// One refinement step: the new points as stencils over the old ones (`None` where the rule
-    /// needs faces beyond a rim) and the new faces. Children of face `f` come in order; see
-    /// [`children_per_face`].
-    pub fn refine(&self, scheme: Scheme) -> Refined {
-        match scheme {
-            Scheme::Loop => self.refine_primal(scheme),
-            Scheme::CatmullClark => self.refine_primal(scheme),
-            Scheme::DooSabin => self.refine_doo_sabin(),
-        }
-    }
-
-    fn refine_primal(&self, scheme: Scheme) -> Refined {
+    /// One refinement step of a primal scheme (Loop, Catmull–Clark): the new points as
+    /// stencils over the old ones (`None` where the rule needs faces beyond a rim) and the new
+    /// faces. Children of face `f` come in order; see [`children_per_face`]. Doo–Sabin's dual
+    /// step is `doo_sabin::refine`; `step::refine_step` picks the one of a scheme.
+    pub fn refine_primal(&self, scheme: Scheme) -> Refined {
         let (nv, ne, nf) = (self.nv, self.edges.len(), self.num_faces());
         let with_faces = scheme == Scheme::CatmullClark;
         let mut points: Vec<Option<Stencil>> = Vec::with_capacity(nv + ne + nf);
@@ -267,12 +261,6 @@ impl Topo {
             tags.get(&(a, b)).copied().unwrap_or_default()
         });
         Refined { points, topo }
-    }
-
-    fn refine_doo_sabin(&self) -> Refined {
-        // Doo–Sabin is dual: one new point per face corner, faces for old faces, edges and
-        // vertices. Implemented in the doo_sabin module.
-        super::doo_sabin::refine(self)
     }
 
     fn face_point(&self, f: u32) -> Stencil {
@@ -413,7 +401,31 @@ impl Topo {
     }
 }
 
-/// Result of [`Topo::refine`].
+impl Topo {
+    /// The edge-tagged topology of a control mesh (sharp and open edges tagged).
+    pub fn of_control_mesh(mesh: &ControlMesh) -> Topo {
+        let mut starts = vec![0u32];
+        let mut verts = Vec::new();
+        for f in 0..mesh.num_faces() as u32 {
+            verts.extend(mesh.face_vertices(f));
+            starts.push(verts.len() as u32);
+        }
+        Topo::new(mesh.num_vertices(), starts, verts, |a, b| {
+            let h = mesh
+                .find_half_edge(a, b)
+                .or_else(|| mesh.find_half_edge(b, a));
+            match h {
+                Some(h) => EdgeTag {
+                    sharp: mesh.is_sharp(h),
+                    open: mesh.is_boundary_edge(h),
+                },
+                None => EdgeTag::default(),
+            }
+        })
+    }
+}
+
+/// Result of [`Topo::refine_primal`] and `doo_sabin::refine`.
 pub(crate) struct Refined {
     pub points: Vec<Option<Stencil>>,
     pub topo: Topo,

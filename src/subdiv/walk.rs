@@ -2,7 +2,7 @@
 //! that holds the point, mapping parameters through the shared edge (neighbouring patches are
 //! unfolded into one plane across it), and clamp onto the domain at open boundaries.
 
-use super::surface::DooSabinSites;
+use super::sites::DooSabinSites;
 use super::topo::NO;
 use super::{Scheme, SurfaceParam};
 use crate::mesh::{ControlMesh, NONE};

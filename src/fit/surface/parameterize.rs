@@ -8,13 +8,13 @@
 //! more than the sampling allows) the parameters are wrong. Such points are detected and,
 //! by [`FoldPolicy`], reported as an error, excluded from the fit, or kept.
 
-use super::FitError;
+use crate::fit::FitError;
 use crate::geom::{symmetric_eigen, Point3, Vec3};
-use crate::spline::{BSplineSurface, NewtonOptions};
+use crate::geom::{ClosestPoint, NewtonOptions};
+use crate::spline::BSplineSurface;
 
 /// What to do with points on a fold-over of the projection.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum FoldPolicy {
     /// Fail with [`FitError::FoldedProjection`].
     Fail,
@@ -25,6 +25,8 @@ pub enum FoldPolicy {
     #[default]
     Keep,
 }
+
+named_enum!(FoldPolicy, "folded", { Fail => "fail", Exclude => "exclude", Keep => "keep" });
 
 /// Options of [`parameterize`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,16 +47,19 @@ pub struct ParamOptions {
 
 impl Default for ParamOptions {
     fn default() -> Self {
-        ParamOptions {
-            view: None,
-            fold_policy: FoldPolicy::Keep,
-            fold_gap_cells: 4.0,
-            min_area: true,
-        }
+        ParamOptions::DEFAULT
     }
 }
 
 impl ParamOptions {
+    /// The defaults, as each field documents them.
+    pub const DEFAULT: ParamOptions = ParamOptions {
+        view: None,
+        fold_policy: FoldPolicy::Keep,
+        fold_gap_cells: 4.0,
+        min_area: true,
+    };
+
     /// Sets the view direction.
     pub fn with_view(mut self, view: Vec3) -> Self {
         self.view = Some(view);
@@ -284,11 +289,10 @@ pub fn parameterize_on_surface(
                     .total_cmp(&(b.2 - *p).length_squared())
             })
             .map_or((u0, v0), |s| (s.0, s.1));
-        let near = base.closest_point(*p, seed.0, seed.1, NewtonOptions::default());
-        let d = base.derivs(near.u, near.v, 1);
-        let normal = d.skl[1][0].cross(d.skl[0][1]).normalize_or_zero();
-        uv.push([(near.u - u0) / (u1 - u0), (near.v - v0) / (v1 - v0)]);
-        depth.push((*p - near.point).dot(normal));
+        let near = base.closest_point_from(*p, [seed.0, seed.1], &NewtonOptions::DEFAULT);
+        let [u, v] = near.param;
+        uv.push([(u - u0) / (u1 - u0), (v - v0) / (v1 - v0)]);
+        depth.push((*p - near.point).dot(near.direction));
     }
     let folded = detect_folds(
         &uv,

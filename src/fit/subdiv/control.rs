@@ -1,14 +1,11 @@
 //! The fitter's view of the subdivision library: [`SubdivSurface`] as a [`ControlSurface`],
-//! with each scheme's refinement and remeshing.
+//! refined and remeshed by the library's own local rules (`subdiv::adaptive`).
 
-use super::refine::{improve_by_flips, split_triangles, SplitRule};
-use super::refine_ds::split_polygons;
-use super::refine_quad::split_quads;
-use super::subdiv::{ControlSurface, SubdivFitter};
-use super::{FitError, SubdivFitOptions};
+use super::{ControlSurface, SubdivFitOptions, SubdivFitter};
+use crate::fit::FitError;
 use crate::geom::Point3;
 use crate::mesh::{ControlMesh, PolyMesh};
-use crate::subdiv::{quadrangulate, LimitSurface, Scheme, SubdivSurface};
+use crate::subdiv::{adaptive, quadrangulate, LimitSurface, Scheme, SubdivSurface};
 
 /// The limit surface of `control` under `scheme`; quad schemes accept any polygon mesh and turn
 /// it into quads first (one Catmull–Clark step) when it is not all quads.
@@ -21,9 +18,7 @@ pub fn surface_of(scheme: Scheme, control: &PolyMesh) -> Result<SubdivSurface, F
 
 /// The control mesh of `control` for `scheme` (quads for the quad schemes).
 fn control_mesh_of(scheme: Scheme, control: &PolyMesh) -> Result<ControlMesh, FitError> {
-    let mesh = ControlMesh::try_new(control).map_err(|e| FitError::ControlMesh {
-        reason: e.to_string(),
-    })?;
+    let mesh = ControlMesh::try_new(control)?;
     Ok(match scheme {
         Scheme::Loop => mesh,
         _ if mesh.is_quad_mesh() => mesh,
@@ -35,12 +30,8 @@ fn control_mesh_of(scheme: Scheme, control: &PolyMesh) -> Result<ControlMesh, Fi
 }
 
 impl ControlSurface for SubdivSurface {
-    fn scheme_name(&self) -> &'static str {
-        match self.scheme() {
-            Scheme::Loop => "loop",
-            Scheme::CatmullClark => "catmull-clark",
-            Scheme::DooSabin => "doo-sabin",
-        }
+    fn scheme(&self) -> Scheme {
+        SubdivSurface::scheme(self)
     }
 
     fn control_polygons(&self) -> PolyMesh {
@@ -48,13 +39,13 @@ impl ControlSurface for SubdivSurface {
     }
 
     fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError> {
-        Ok(self.with_mesh(control_mesh_of(self.scheme(), control)?)?)
+        Ok(self.with_mesh(control_mesh_of(SubdivSurface::scheme(self), control)?)?)
     }
 
     /// Loop and Catmull–Clark patches are the control faces. Doo–Sabin patches sit at
     /// (face, vertex) sites and belong to that face.
     fn patch_face(&self, patch: u32) -> usize {
-        match self.scheme() {
+        match SubdivSurface::scheme(self) {
             Scheme::DooSabin => self
                 .patch_site(patch)
                 .map_or(usize::MAX, |(f, _)| f as usize),
@@ -62,15 +53,12 @@ impl ControlSurface for SubdivSurface {
         }
     }
 
-    /// Loop: red–green splitting with Loop's masks. Catmull–Clark: local conforming quad
-    /// splitting with transition templates and Catmull–Clark's masks. Doo–Sabin: marked
-    /// faces split into quads around their centroids, neighbours gain the edge midpoints.
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
-        match self.scheme() {
-            Scheme::Loop => split_triangles(control, marked, SplitRule::Loop),
-            Scheme::CatmullClark => split_quads(control, marked),
-            Scheme::DooSabin => split_polygons(control, marked),
-        }
+        Ok(adaptive::refine_marked(
+            SubdivSurface::scheme(self),
+            control,
+            marked,
+        )?)
     }
 
     fn kept_patch(&self, patch: u32) -> Option<u32> {
@@ -78,10 +66,12 @@ impl ControlSurface for SubdivSurface {
     }
 
     fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
-        match self.scheme() {
-            Scheme::Loop => improve_by_flips(control, 3, self.control_points().len() as u32),
-            _ => Ok(0),
-        }
+        let first_new = self.control_points().len() as u32;
+        Ok(adaptive::remesh(
+            SubdivSurface::scheme(self),
+            control,
+            first_new,
+        )?)
     }
 }
 

@@ -1,22 +1,38 @@
 //! The subdivision-surface fitter (SPEC §1): foot points by Newton on the limit surface, error
 //! vectors, weighted control-point moves, acceleration with damping, and local refinement.
 
+mod control;
+mod frozen;
+mod index;
+mod options;
+mod setup;
+
+pub use control::surface_of;
+pub use options::{SubdivFitOptions, Weighting};
+pub(crate) use setup::build_subdiv_fitter;
+pub use setup::{default_initial_count, initial_control, ReconstructionReport};
+
 use super::accel::Accelerator;
-use super::closest::{closest_point, FootPoint, SurfaceIndex};
-use super::frozen::Stencils;
-use super::options::{Acceleration, SubdivFitOptions, Weighting};
-use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
-use crate::geom::{Aabb, Point3, Vec3};
+use super::{
+    Acceleration, ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape,
+    Tolerances,
+};
+use crate::geom::{Aabb, ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
-use crate::subdiv::{LimitSurface, PatchDomain, SurfaceParam};
+use crate::subdiv::{tessellate, LimitSurface, SurfaceParam};
+use frozen::Stencils;
+use index::SurfaceIndex;
 use std::collections::HashSet;
 use web_time::Instant;
 
+/// A data point's foot point on the limit surface.
+type FootPoint = Nearest<SurfaceParam>;
+
 /// A limit surface the fitter can rebuild from a control mesh, so that refinement (which changes
 /// the connectivity) can continue with the same scheme.
-pub trait ControlSurface: LimitSurface + Sized {
-    /// The scheme's name in reports and on the command line (`loop`, `catmull-clark`, ...).
-    fn scheme_name(&self) -> &'static str;
+pub trait ControlSurface: LimitSurface + ClosestPoint<Param = SurfaceParam> + Sized {
+    /// The subdivision scheme.
+    fn scheme(&self) -> crate::subdiv::Scheme;
 
     /// The control mesh: polygons and current control points. Face `i` holds patch `i`'s
     /// foot points as far as [`ControlSurface::patch_face`] says.
@@ -55,7 +71,7 @@ pub trait ControlSurface: LimitSurface + Sized {
 ///
 /// Build it with [`SubdivFitter::try_new`], then drive it through [`Fitter`]. Everything before
 /// the first iteration (surface set-up, spatial index, first foot points) is the precompute
-/// phase, timed by [`SubdivFitter::precompute_seconds`].
+/// phase, timed in its [`FitLog`].
 pub struct SubdivFitter<S: ControlSurface> {
     data: Vec<Point3>,
     diagonal: f64,
@@ -63,14 +79,13 @@ pub struct SubdivFitter<S: ControlSurface> {
     feet: Vec<FootPoint>,
     signed: Vec<f64>,
     stats: ErrorStats,
-    history: Vec<IterationRecord>,
+    log: FitLog,
     options: SubdivFitOptions,
-    initial_control: usize,
+    /// `options.newton` with its step tolerance in model units.
+    newton: NewtonOptions,
     since_refine: usize,
     accel: Accelerator,
     index: SurfaceIndex,
-    status: FitStatus,
-    precompute_s: f64,
     scratch: Vec<(u32, f64)>,
 }
 
@@ -93,47 +108,31 @@ impl<S: ControlSurface> SubdivFitter<S> {
         })?;
         let control = surface.control_polygons();
         if control.num_faces() == 0 || surface.num_patches() == 0 {
-            return Err(FitError::ControlMesh {
-                reason: "the control mesh has no faces".into(),
-            });
+            return Err(FitError::EmptyControlMesh);
         }
         let index = SurfaceIndex::build(&surface, options.index_resolution);
         let diagonal = bbox.diagonal();
+        let diagonal = if diagonal > 0.0 { diagonal } else { 1.0 };
         let mut fitter = SubdivFitter {
             data: data_points.to_vec(),
-            diagonal: if diagonal > 0.0 { diagonal } else { 1.0 },
-            initial_control: control.num_vertices(),
+            diagonal,
+            log: FitLog::new(control.num_vertices(), start),
             surface,
             feet: Vec::new(),
             signed: Vec::new(),
             stats: ErrorStats::default(),
-            history: Vec::new(),
+            newton: options
+                .newton
+                .with_step_tol(options.newton.step_tol * diagonal),
             options,
             since_refine: 0,
             accel: Accelerator::new(options.acceleration),
             index,
-            status: FitStatus::Running,
-            precompute_s: 0.0,
             scratch: Vec::new(),
         };
         fitter.search_all_feet()?;
-        fitter.precompute_s = start.elapsed().as_secs_f64();
+        fitter.log = FitLog::new(fitter.log.initial_control_points(), start);
         Ok(fitter)
-    }
-
-    /// Seconds spent in [`SubdivFitter::try_new`].
-    pub fn precompute_seconds(&self) -> f64 {
-        self.precompute_s
-    }
-
-    /// The data points, in input order.
-    pub fn data(&self) -> &[Point3] {
-        &self.data
-    }
-
-    /// Diagonal of the data's bounding box: what the `_pct` figures are relative to.
-    pub fn diagonal(&self) -> f64 {
-        self.diagonal
     }
 
     /// The current limit surface.
@@ -144,16 +143,6 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// The current control mesh (connectivity and control points).
     pub fn control_mesh(&self) -> PolyMesh {
         self.surface.control_polygons()
-    }
-
-    /// Number of control points now.
-    pub fn num_control_points(&self) -> usize {
-        self.surface.control_points().len()
-    }
-
-    /// Number of control points the fit started with.
-    pub fn initial_control_points(&self) -> usize {
-        self.initial_control
     }
 
     /// Current foot point of every data point, in data order.
@@ -175,15 +164,11 @@ impl<S: ControlSurface> SubdivFitter<S> {
         &self.options
     }
 
-    /// Where the fit stands.
-    pub fn status(&self) -> FitStatus {
-        self.status
-    }
-
-    /// The limit surface tessellated with `resolution` segments per patch edge, for display and
-    /// export (patches are not welded to each other).
+    /// The limit surface tessellated with `resolution` segments per patch edge (clamped to
+    /// 1..=64), for display and export (patches are not welded to each other).
     pub fn limit_mesh(&self, resolution: usize) -> PolyMesh {
-        tessellate(&self.surface, resolution.clamp(1, 64))
+        let t = tessellate(&self.surface, resolution.clamp(1, 64));
+        PolyMesh::try_new(t.positions, t.triangles).unwrap_or_default()
     }
 
     /// The control-point budget: the option, or half the number of data points.
@@ -191,18 +176,19 @@ impl<S: ControlSurface> SubdivFitter<S> {
         self.options
             .max_control
             .unwrap_or(self.data.len() / 2)
-            .max(self.initial_control)
+            .max(self.log.initial_control_points())
     }
 
     /// Global search: every foot point from the spatial index, then Newton.
     fn search_all_feet(&mut self) -> Result<(), FitError> {
-        let opts = self.options.newton;
+        let opts = self.newton;
         let mut feet = Vec::with_capacity(self.data.len());
         for (i, &p) in self.data.iter().enumerate() {
-            let start = self.index.nearest(p).ok_or_else(|| FitError::ControlMesh {
-                reason: format!("the limit surface has no finite point near data point {i}"),
-            })?;
-            feet.push(closest_point(&self.surface, p, start, &opts, self.diagonal));
+            let start = self
+                .index
+                .nearest(p)
+                .ok_or(FitError::NoSurfaceNear { point: i })?;
+            feet.push(self.surface.closest_point_from(p, start, &opts));
         }
         self.feet = feet;
         self.update_errors();
@@ -213,15 +199,15 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// converged, or much farther than before) is searched again from the spatial index, and
     /// the better of the two results is kept.
     fn update_feet(&mut self, previous: &[FootPoint]) {
-        let opts = self.options.newton;
+        let opts = self.newton;
         let slack = 1e-3 * self.diagonal;
         for (i, &p) in self.data.iter().enumerate() {
             let prev = previous[i];
-            let mut foot = closest_point(&self.surface, p, prev.param, &opts, self.diagonal);
+            let mut foot = self.surface.closest_point_from(p, prev.param, &opts);
             let grew = foot.dist_sq.sqrt() > 2.0 * prev.dist_sq.sqrt() + slack;
             if !foot.converged || grew {
                 if let Some(start) = self.index.nearest(p) {
-                    let other = closest_point(&self.surface, p, start, &opts, self.diagonal);
+                    let other = self.surface.closest_point_from(p, start, &opts);
                     if other.dist_sq < foot.dist_sq {
                         foot = other;
                     }
@@ -237,7 +223,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         self.signed.clear();
         for (p, f) in self.data.iter().zip(&self.feet) {
             let d = f.dist_sq.sqrt();
-            let side = (*p - f.point).dot(f.normal);
+            let side = (*p - f.point).dot(f.direction);
             let s = if side < 0.0 { -d } else { d };
             self.signed.push(if s.is_finite() { s } else { f64::MAX });
         }
@@ -279,7 +265,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let d = match self.options.acceleration {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
-                let normals: Vec<Vec3> = self.feet.iter().map(|f| f.normal).collect();
+                let normals: Vec<Vec3> = self.feet.iter().map(|f| f.direction).collect();
                 stencils.cg(
                     &self.error_vectors(),
                     &normals,
@@ -441,7 +427,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 face_patch.insert(refined.face(f).to_vec(), p);
             }
         }
-        let opts = self.options.newton;
+        let opts = self.newton;
         for i in 0..self.data.len() {
             let (p, prev) = (self.data[i], self.feet[i].param);
             if let Some(&patch) = copy_of.get(prev.patch as usize).filter(|&&c| c != u32::MAX) {
@@ -452,23 +438,17 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .get(prev.patch as usize)
                 .and_then(|corners| face_patch.get(corners));
             let warm = kept.map(|&patch| {
-                closest_point(
-                    &self.surface,
-                    p,
-                    SurfaceParam { patch, ..prev },
-                    &opts,
-                    self.diagonal,
-                )
+                self.surface
+                    .closest_point_from(p, SurfaceParam { patch, ..prev }, &opts)
             });
             self.feet[i] = match warm {
                 Some(foot) if foot.converged => foot,
                 _ => {
-                    let start = self.index.nearest(p).ok_or_else(|| FitError::ControlMesh {
-                        reason: format!(
-                            "the limit surface has no finite point near data point {i}"
-                        ),
-                    })?;
-                    closest_point(&self.surface, p, start, &opts, self.diagonal)
+                    let start = self
+                        .index
+                        .nearest(p)
+                        .ok_or(FitError::NoSurfaceNear { point: i })?;
+                    self.surface.closest_point_from(p, start, &opts)
                 }
             };
         }
@@ -486,12 +466,11 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
 impl<S: ControlSurface> Fitter for SubdivFitter<S> {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.status != FitStatus::Running {
-            return Ok(self.status);
+        if self.log.status() != FitStatus::Running {
+            return Ok(self.log.status());
         }
         if self.options.tolerances.met_by(&self.stats) {
-            self.status = FitStatus::Converged;
-            return Ok(self.status);
+            return Ok(self.log.stop(FitStatus::Converged));
         }
         let start = Instant::now();
         let before = self.stats.e_rms;
@@ -509,28 +488,43 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
                 self.since_refine = 0;
             }
         }
-        let iter = self.history.len() + 1;
-        self.history.push(IterationRecord {
-            iter,
-            control_points: self.num_control_points(),
-            e_avg_pct: self.stats.e_avg_pct,
-            e_max_pct: self.stats.e_max_pct,
-            e_rms_pct: self.stats.e_rms_pct,
-            ms: start.elapsed().as_secs_f64() * 1e3,
-            refined,
-        });
-        self.status = if self.options.tolerances.met_by(&self.stats) {
+        let status = if self.options.tolerances.met_by(&self.stats) {
             FitStatus::Converged
-        } else if iter >= self.options.max_iter {
+        } else if self.log.iterations() + 1 >= self.options.max_iter {
             FitStatus::MaxIterations
         } else {
             FitStatus::Running
         };
-        Ok(self.status)
+        let n = self.num_control_points();
+        Ok(self.log.record(start, n, &self.stats, refined, status))
     }
 
-    fn history(&self) -> &[IterationRecord] {
-        &self.history
+    fn scheme(&self) -> Scheme {
+        Scheme::from(self.surface.scheme())
+    }
+
+    fn method(&self) -> Method {
+        Method::Geometric
+    }
+
+    fn log(&self) -> &FitLog {
+        &self.log
+    }
+
+    fn log_mut(&mut self) -> &mut FitLog {
+        &mut self.log
+    }
+
+    fn tolerances(&self) -> Tolerances {
+        self.options.tolerances
+    }
+
+    fn data(&self) -> &[Point3] {
+        &self.data
+    }
+
+    fn diagonal(&self) -> f64 {
+        self.diagonal
     }
 
     fn point_errors(&self) -> &[f64] {
@@ -540,54 +534,20 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
     fn stats(&self) -> ErrorStats {
         self.stats
     }
-}
 
-/// Tessellates every patch with `r` segments per edge.
-fn tessellate<S: LimitSurface + ?Sized>(surface: &S, r: usize) -> PolyMesh {
-    let mut points = Vec::new();
-    let mut tris: Vec<[u32; 3]> = Vec::new();
-    let h = 1.0 / r as f64;
-    for patch in 0..surface.num_patches() as u32 {
-        let base = points.len() as u32;
-        let at = |u: f64, v: f64| surface.eval(SurfaceParam { patch, u, v }).point;
-        match surface.domain() {
-            PatchDomain::Square => {
-                for i in 0..=r {
-                    for j in 0..=r {
-                        points.push(at(i as f64 * h, j as f64 * h));
-                    }
-                }
-                let id = |i: usize, j: usize| base + (i * (r + 1) + j) as u32;
-                for i in 0..r {
-                    for j in 0..r {
-                        tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-                        tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-                    }
-                }
-            }
-            PatchDomain::Triangle => {
-                let mut row_start = Vec::with_capacity(r + 1);
-                for i in 0..=r {
-                    row_start.push(points.len() as u32 - base);
-                    for j in 0..=r - i {
-                        points.push(at(i as f64 * h, j as f64 * h));
-                    }
-                }
-                let id = |i: usize, j: usize| base + row_start[i] + j as u32;
-                for i in 0..r {
-                    for j in 0..r - i {
-                        tris.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
-                        if j + 1 < r - i {
-                            tris.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-                        }
-                    }
-                }
-            }
-        }
+    fn foot_points(&self) -> Vec<Point3> {
+        self.feet.iter().map(|f| f.point).collect()
     }
-    let points = points
-        .into_iter()
-        .map(|p| if p.is_finite() { p } else { Point3::ZERO })
-        .collect();
-    PolyMesh::try_new(points, tris).unwrap_or_default()
+
+    fn num_control_points(&self) -> usize {
+        self.surface.control_points().len()
+    }
+
+    fn control_shape(&self) -> Shape {
+        Shape::Mesh(self.control_mesh())
+    }
+
+    fn limit_shape(&self, resolution: usize) -> Shape {
+        Shape::Mesh(self.limit_mesh(resolution))
+    }
 }

@@ -1,8 +1,8 @@
-//! Building a subdivision fitter from a loaded data file: the one path the command line and the
-//! wasm API share (a mesh for bare points, initial control mesh by QEM simplification, scheme
-//! set-up, fitter).
+//! Building a subdivision fitter from loaded data: a mesh for bare points, the initial control
+//! mesh by QEM simplification, scheme set-up, fitter. [`crate::fit::FitSpec::build`] calls it.
 
-use super::{FitError, SubdivFitOptions, SubdivFitter};
+use super::{SubdivFitOptions, SubdivFitter};
+use crate::fit::{FitError, Fitter};
 use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
 use crate::geom::Point3;
 use crate::io::RangeGrid;
@@ -23,15 +23,11 @@ pub fn default_initial_count(n: usize, used: usize) -> usize {
 /// [`build_subdiv_fitter`] does).
 pub fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<PolyMesh, FitError> {
     if data.is_point_cloud() {
-        return Err(FitError::ControlMesh {
-            reason: "the data has no faces; reconstruct a mesh from the points first".into(),
-        });
+        return Err(FitError::NoFaces);
     }
     let used = used_vertices(data);
     let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
-    crate::mesh::simplify::simplify(data, target).map_err(|e| FitError::ControlMesh {
-        reason: format!("simplification: {e}"),
-    })
+    Ok(crate::mesh::simplify::simplify(data, target)?)
 }
 
 /// What [`build_subdiv_fitter`] made of bare points before simplifying: goes into the fit
@@ -52,14 +48,6 @@ pub struct ReconstructionReport {
     pub seconds: f64,
 }
 
-/// A fitter ready to iterate, with what was reconstructed on the way (for point clouds).
-pub struct SubdivSetup {
-    /// The fitter.
-    pub fitter: SubdivFitter<SubdivSurface>,
-    /// `Some` when the data had no faces and a mesh was reconstructed from the points.
-    pub reconstruction: Option<ReconstructionReport>,
-}
-
 /// A fitter of the data points by the limit surface of `scheme`, starting from `control` when
 /// given, else from a QEM simplification to `initial` vertices of the data mesh.
 ///
@@ -67,37 +55,32 @@ pub struct SubdivSetup {
 /// into a mesh by [`crate::cloud::reconstruct`] with `cloud` (open or closed, outlier
 /// removal), using the scanner's `grid` when there is one; the fit then runs on the original
 /// points (less those removed as outliers), not on the reconstructed vertices.
-pub fn build_subdiv_fitter(
+/// The reconstruction, when there was one, is in the fitter's log.
+pub(crate) fn build_subdiv_fitter(
     data: &PolyMesh,
     grid: Option<&RangeGrid>,
     cloud: &ReconstructOptions,
     scheme: Scheme,
-    control: Option<PolyMesh>,
+    control: Option<&PolyMesh>,
     initial: Option<usize>,
     options: SubdivFitOptions,
-) -> Result<SubdivSetup, FitError> {
+) -> Result<SubdivFitter<SubdivSurface>, FitError> {
     options.validate()?;
     if !data.is_point_cloud() {
         let control = match control {
-            Some(mesh) => mesh,
+            Some(mesh) => mesh.clone(),
             None => initial_control(data, initial)?,
         };
-        let fitter = SubdivFitter::try_new(data.positions(), control, scheme, options)?;
-        return Ok(SubdivSetup {
-            fitter,
-            reconstruction: None,
-        });
+        return SubdivFitter::try_new(data.positions(), control, scheme, options);
     }
     let (points, mesh, report) = reconstruct_cloud(data.positions(), grid, cloud)?;
     let control = match control {
-        Some(mesh) => mesh,
+        Some(mesh) => mesh.clone(),
         None => initial_control(&mesh, initial)?,
     };
-    let fitter = SubdivFitter::try_new(&points, control, scheme, options)?;
-    Ok(SubdivSetup {
-        fitter,
-        reconstruction: Some(report),
-    })
+    let mut fitter = SubdivFitter::try_new(&points, control, scheme, options)?;
+    fitter.log_mut().set_reconstruction(Some(report));
+    Ok(fitter)
 }
 
 /// The points to fit (outliers dropped), the mesh reconstructed from them and its report.

@@ -3,13 +3,14 @@
 //! points of the foot point's span by basis value and normalised per control point, with
 //! acceleration, damping and knot insertion where the error stays above tolerance.
 //!
-//! The data helpers here (validation, chord-length parameters, foot points) are shared with the
-//! least-squares knot-placement fitter in [`super::knot_placement`].
-
-use super::accel::Accelerator;
-use super::{Acceleration, ErrorStats, FitError, FitStatus, Fitter, IterationRecord, Tolerances};
-use crate::geom::{Aabb, Point3, Vec3};
-use crate::spline::{BSplineCurve, NewtonOptions, MAX_CURVE_DEGREE};
+use super::{check_degree, control_polygon, curve_shape, details, scheme_of, CurveData};
+use crate::fit::accel::Accelerator;
+use crate::fit::{
+    Acceleration, ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline,
+    Tolerances,
+};
+use crate::geom::{Point3, Vec3};
+use crate::spline::BSplineCurve;
 use web_time::Instant;
 
 /// Options of the geometric curve fitter. Defaults in brackets on each field.
@@ -26,13 +27,16 @@ pub struct CurveFitOptions {
     pub max_iter: usize,
     /// Douglas–Peucker tolerance for the initial control points, % of the bbox diagonal [1.0].
     pub simplify_pct: f64,
+    /// Whether knots are inserted where the tolerance is missed [true].
+    pub refine: bool,
     /// Largest number of control points knot insertion may reach [the number of data points].
     pub max_control: Option<usize>,
     /// Insert knots at the latest after this many iterations without meeting the tolerances [8].
     pub refine_interval: usize,
     /// Insert knots earlier when one iteration lowers E_max by less than this fraction [0.02].
     pub stall_ratio: f64,
-    /// Acceleration of the iteration [Anderson, depth 5].
+    /// Acceleration of the iteration [plain: [`Acceleration::None`]]; an accelerated move that
+    /// raises E_rms is replaced by the plain one.
     pub acceleration: Acceleration,
     /// Share of the spans above tolerance that get a knot per refinement, worst first, in
     /// (0, 1] [0.34]. Smaller shares give fewer control points for more iterations (bunny
@@ -42,203 +46,59 @@ pub struct CurveFitOptions {
     pub newton_iter: usize,
 }
 
-impl Default for CurveFitOptions {
-    fn default() -> Self {
-        CurveFitOptions {
-            degree: 3,
-            closed: false,
-            tolerances: Tolerances::default(),
-            max_iter: 300,
-            simplify_pct: 1.0,
-            max_control: None,
-            refine_interval: 8,
-            stall_ratio: 0.02,
-            acceleration: Acceleration::default(),
-            refine_fraction: 0.34,
-            newton_iter: 8,
-        }
-    }
-}
-
 impl CurveFitOptions {
-    /// Sets the degree.
-    pub fn with_degree(mut self, degree: usize) -> Self {
-        self.degree = degree;
-        self
-    }
-    /// Sets whether the curve is closed.
-    pub fn with_closed(mut self, closed: bool) -> Self {
-        self.closed = closed;
-        self
-    }
-    /// Sets the tolerances.
-    pub fn with_tolerances(mut self, tolerances: Tolerances) -> Self {
-        self.tolerances = tolerances;
-        self
-    }
-    /// Sets the iteration cap.
-    pub fn with_max_iter(mut self, max_iter: usize) -> Self {
-        self.max_iter = max_iter;
-        self
-    }
-    /// Sets the Douglas–Peucker tolerance, % of the bbox diagonal.
-    pub fn with_simplify_pct(mut self, pct: f64) -> Self {
-        self.simplify_pct = pct;
-        self
-    }
-    /// Sets the control-point budget of knot insertion.
-    pub fn with_max_control(mut self, max_control: Option<usize>) -> Self {
-        self.max_control = max_control;
-        self
-    }
-    /// Sets the acceleration.
-    pub fn with_acceleration(mut self, acceleration: Acceleration) -> Self {
-        self.acceleration = acceleration;
-        self
-    }
+    /// The defaults, as each field documents them.
+    pub const DEFAULT: CurveFitOptions = CurveFitOptions {
+        degree: 3,
+        closed: false,
+        tolerances: Tolerances::DEFAULT,
+        max_iter: 300,
+        simplify_pct: 1.0,
+        refine: true,
+        max_control: None,
+        refine_interval: 8,
+        stall_ratio: 0.02,
+        acceleration: Acceleration::None,
+        refine_fraction: 0.34,
+        newton_iter: 8,
+    };
 
-    fn validate(&self) -> Result<(), FitError> {
+    /// Checks every option's range.
+    pub fn validate(&self) -> Result<(), FitError> {
         let bad = |name, reason: String| Err(FitError::InvalidOption { name, reason });
-        if !(1..=MAX_CURVE_DEGREE).contains(&self.degree) {
-            return bad(
-                "degree",
-                format!("{} is not in 1..={MAX_CURVE_DEGREE}", self.degree),
-            );
-        }
+        check_degree(self.degree)?;
         if !(self.simplify_pct.is_finite() && self.simplify_pct > 0.0) {
             return bad(
-                "simplify",
+                "simplifyPct",
                 format!("{} must be positive", self.simplify_pct),
             );
         }
         if self.refine_interval == 0 {
-            return bad("refine-interval", "must be at least 1".into());
+            return bad("refineInterval", "must be at least 1".into());
         }
-        check_tolerances(&self.tolerances)?;
-        match self.acceleration {
-            Acceleration::Relax { omega } if !(omega > 0.0 && omega < 2.0) => bad(
-                "accel",
-                format!("relaxation factor {omega} is not in (0, 2)"),
-            ),
-            Acceleration::Anderson { depth } if !(1..=20).contains(&depth) => {
-                bad("accel", format!("Anderson depth {depth} is not in 1..=20"))
-            }
-            _ => Ok(()),
-        }
+        self.tolerances.validate()?;
+        self.acceleration.validate()
     }
 }
 
-/// Rejects negative or non-finite tolerances.
-pub(crate) fn check_tolerances(t: &Tolerances) -> Result<(), FitError> {
-    for (name, v) in [
-        ("tol-avg", t.avg_pct),
-        ("tol-max", t.max_pct),
-        ("tol-rms", t.rms_pct),
-    ] {
-        if let Some(v) = v.filter(|v| !(v.is_finite() && *v >= 0.0)) {
-            return Err(FitError::InvalidOption {
-                name,
-                reason: format!("{v} is not a non-negative percentage"),
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Ordered curve data with its chord-length parameters and scale.
-#[derive(Clone, Debug)]
-pub(crate) struct CurveData {
-    pub points: Vec<Point3>,
-    /// Chord-length parameters on [0, 1]; for a closed curve the closing segment counts and the
-    /// last point sits before 1.
-    pub chord: Vec<f64>,
-    pub diagonal: f64,
-    /// Length of the polyline (closing segment included for closed curves).
-    pub length: f64,
-    /// All points share one z: errors get a sign from the in-plane normal.
-    pub planar: bool,
-}
-
-impl CurveData {
-    /// Checks and parameterises `points`: at least `needed`, finite, no point equal to the one
-    /// before it. A closed polyline given with its first point repeated at the end loses the
-    /// repeat.
-    pub fn try_new(points: &[Point3], closed: bool, needed: usize) -> Result<CurveData, FitError> {
-        if let Some(index) = points.iter().position(|p| !p.is_finite()) {
-            return Err(FitError::NonFinitePoint { index });
-        }
-        let mut points = points.to_vec();
-        if closed && points.len() > 1 && points.first() == points.last() {
-            points.pop();
-        }
-        if points.len() < needed {
-            return Err(FitError::TooFewPoints {
-                found: points.len(),
-                needed,
-            });
-        }
-        if let Some(i) = (1..points.len()).find(|&i| points[i] == points[i - 1]) {
-            return Err(FitError::DuplicatePoint { index: i });
-        }
-        let bbox = Aabb::from_points(&points).ok_or(FitError::TooFewPoints { found: 0, needed })?;
-        let mut chord = vec![0.0];
-        for w in points.windows(2) {
-            chord.push(chord[chord.len() - 1] + (w[1] - w[0]).length());
-        }
-        let total = chord[chord.len() - 1]
-            + if closed {
-                (points[0] - points[points.len() - 1]).length()
-            } else {
-                0.0
-            };
-        chord.iter_mut().for_each(|c| *c /= total);
-        Ok(CurveData {
-            planar: bbox.max.z == bbox.min.z,
-            diagonal: bbox.diagonal(),
-            length: total,
-            points,
-            chord,
-        })
-    }
-
-    /// Foot points of every data point on `curve`, Newton from `params`; returns the distances
-    /// (signed for planar data: positive on the left of the direction of travel).
-    pub fn foot_points(
-        &self,
-        curve: &BSplineCurve,
-        params: &mut [f64],
-        newton_iter: usize,
-    ) -> Vec<f64> {
-        // As for surfaces (patches::correct_parameters): a step of 1e-7 of the domain is far
-        // below any fitting tolerance.
-        let opts = NewtonOptions::default()
-            .with_max_iterations(newton_iter)
-            .with_param_tolerance(1e-7);
-        self.points
-            .iter()
-            .zip(params.iter_mut())
-            .map(|(&p, u)| {
-                let near = curve.closest_point_from(p, *u, opts);
-                *u = near.u;
-                self.signed_distance(p, &near)
-            })
-            .collect()
-    }
-
-    fn signed_distance(&self, p: Point3, near: &crate::spline::CurveNearest) -> f64 {
-        let d = near.dist_sq.sqrt();
-        if !self.planar {
-            return d;
-        }
-        let tangent = near.tangent;
-        let normal = Vec3::new(-tangent.y, tangent.x, 0.0);
-        if (p - near.point).dot(normal) < 0.0 {
-            -d
-        } else {
-            d
-        }
+impl Default for CurveFitOptions {
+    fn default() -> Self {
+        CurveFitOptions::DEFAULT
     }
 }
+
+setters!(CurveFitOptions {
+    /// Sets the iteration cap.
+    with_max_iter(max_iter: usize) => |s| s.max_iter;
+    /// Sets the Douglas–Peucker tolerance, % of the bbox diagonal.
+    with_simplify_pct(simplify_pct: f64) => |s| s.simplify_pct;
+    /// Turns knot insertion on or off.
+    with_refine(refine: bool) => |s| s.refine;
+    /// Sets the control-point budget of knot insertion.
+    with_max_control(max_control: Option<usize>) => |s| s.max_control;
+    /// Sets the acceleration.
+    with_acceleration(acceleration: Acceleration) => |s| s.acceleration;
+});
 
 /// Indices of the points Douglas–Peucker keeps between `first` and `last` (both kept) at
 /// distance tolerance `eps`. `at(i)` gives point i; iterative, so long inputs cannot overflow
@@ -359,11 +219,9 @@ pub struct CurveFitter {
     params: Vec<f64>,
     errors: Vec<f64>,
     stats: ErrorStats,
-    history: Vec<IterationRecord>,
+    log: FitLog,
     accel: Accelerator,
     since_refine: usize,
-    status: FitStatus,
-    initial_control: usize,
 }
 
 impl CurveFitter {
@@ -371,6 +229,7 @@ impl CurveFitter {
     /// last point to the first): validates the input, builds the initial curve and its foot
     /// points.
     pub fn try_new(points: &[Point3], options: CurveFitOptions) -> Result<CurveFitter, FitError> {
+        let start = Instant::now();
         options.validate()?;
         let p = options.degree;
         let data = CurveData::try_new(points, options.closed, p + 2)?;
@@ -385,22 +244,19 @@ impl CurveFitter {
             .collect();
         let errors = data.foot_points(&curve, &mut params, options.newton_iter);
         let stats = ErrorStats::from_distances(&errors, data.diagonal);
-        let initial_control = curve.control_points().len();
         let mut fitter = CurveFitter {
             accel: Accelerator::new(options.acceleration),
+            log: FitLog::new(curve.control_points().len(), start),
             data,
             options,
             curve,
             params,
             errors,
             stats,
-            history: Vec::new(),
             since_refine: 0,
-            status: FitStatus::Running,
-            initial_control,
         };
         if fitter.options.tolerances.met_by(&fitter.stats) {
-            fitter.status = FitStatus::Converged;
+            fitter.log.stop(FitStatus::Converged);
         }
         Ok(fitter)
     }
@@ -413,21 +269,6 @@ impl CurveFitter {
     /// The foot-point parameter of every data point.
     pub fn params(&self) -> &[f64] {
         &self.params
-    }
-
-    /// The data points (a closing repeat of the first point removed).
-    pub fn data(&self) -> &[Point3] {
-        &self.data.points
-    }
-
-    /// Control points of the initial curve.
-    pub fn initial_control_points(&self) -> usize {
-        self.initial_control
-    }
-
-    /// Where the fit stands.
-    pub fn status(&self) -> FitStatus {
-        self.status
     }
 
     /// Per control point, the basis-weighted mean of the error vectors of the foot points in
@@ -508,11 +349,14 @@ impl CurveFitter {
             .filter(|&(_, e, _)| e > tol)
             .collect();
         worst.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let budget = self
-            .options
-            .max_control
-            .unwrap_or(self.data.points.len())
-            .saturating_sub(self.curve.control_points().len());
+        let budget = if self.options.refine {
+            self.options
+                .max_control
+                .unwrap_or(self.data.points.len())
+                .saturating_sub(self.curve.control_points().len())
+        } else {
+            0
+        };
         // Only the worst share of the offending spans: the others often meet the tolerance
         // after a few more iterations, once their neighbours have more freedom.
         let share = (worst.len() as f64 * self.options.refine_fraction).ceil() as usize;
@@ -534,8 +378,8 @@ impl CurveFitter {
 
 impl Fitter for CurveFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.status != FitStatus::Running {
-            return Ok(self.status);
+        if self.log.status() != FitStatus::Running {
+            return Ok(self.log.status());
         }
         let start = Instant::now();
         let before = self.stats.e_max;
@@ -549,28 +393,43 @@ impl Fitter for CurveFitter {
         if refined {
             self.since_refine = 0;
         }
-        let iter = self.history.len() + 1;
-        self.history.push(IterationRecord {
-            iter,
-            control_points: self.curve.control_points().len(),
-            e_avg_pct: self.stats.e_avg_pct,
-            e_max_pct: self.stats.e_max_pct,
-            e_rms_pct: self.stats.e_rms_pct,
-            ms: start.elapsed().as_secs_f64() * 1e3,
-            refined,
-        });
-        self.status = if met {
+        let status = if met {
             FitStatus::Converged
-        } else if iter >= self.options.max_iter {
+        } else if self.log.iterations() + 1 >= self.options.max_iter {
             FitStatus::MaxIterations
         } else {
             FitStatus::Running
         };
-        Ok(self.status)
+        let n = self.curve.control_points().len();
+        Ok(self.log.record(start, n, &self.stats, refined, status))
     }
 
-    fn history(&self) -> &[IterationRecord] {
-        &self.history
+    fn scheme(&self) -> Scheme {
+        scheme_of(&self.curve)
+    }
+
+    fn method(&self) -> Method {
+        Method::Geometric
+    }
+
+    fn log(&self) -> &FitLog {
+        &self.log
+    }
+
+    fn log_mut(&mut self) -> &mut FitLog {
+        &mut self.log
+    }
+
+    fn tolerances(&self) -> Tolerances {
+        self.options.tolerances
+    }
+
+    fn data(&self) -> &[Point3] {
+        &self.data.points
+    }
+
+    fn diagonal(&self) -> f64 {
+        self.data.diagonal
     }
 
     fn point_errors(&self) -> &[f64] {
@@ -579,6 +438,30 @@ impl Fitter for CurveFitter {
 
     fn stats(&self) -> ErrorStats {
         self.stats
+    }
+
+    fn foot_points(&self) -> Vec<Point3> {
+        self.params.iter().map(|&u| self.curve.eval(u)).collect()
+    }
+
+    fn num_control_points(&self) -> usize {
+        self.curve.control_points().len()
+    }
+
+    fn control_shape(&self) -> Shape {
+        control_polygon(&self.curve)
+    }
+
+    fn limit_shape(&self, resolution: usize) -> Shape {
+        curve_shape(&self.curve, resolution)
+    }
+
+    fn spline(&self) -> Option<Spline<'_>> {
+        Some(Spline::Curve(&self.curve))
+    }
+
+    fn details(&self) -> serde_json::Map<String, serde_json::Value> {
+        details(&self.curve)
     }
 }
 

@@ -14,11 +14,14 @@
 //!
 //! Each [`Fitter::step`] is one insertion and one solve.
 
-use super::curve::{check_tolerances, CurveData};
-use super::curve_lsq::least_squares_curve;
-use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord, Tolerances};
+use super::{
+    check_degree, control_polygon, curve_shape, details, least_squares_curve, scheme_of, CurveData,
+};
+use crate::fit::{
+    ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline, Tolerances,
+};
 use crate::geom::{Point3, Vec3};
-use crate::spline::{BSplineCurve, MAX_CURVE_DEGREE};
+use crate::spline::BSplineCurve;
 use web_time::Instant;
 
 /// Options of the knot-placement fitter. Defaults in brackets on each field.
@@ -58,100 +61,68 @@ pub struct KnotPlacementOptions {
     pub batch: bool,
 }
 
-impl Default for KnotPlacementOptions {
-    fn default() -> Self {
-        KnotPlacementOptions {
-            degree: 3,
-            closed: false,
-            tolerances: Tolerances::default(),
-            std_pct: None,
-            curvature_jump: 1000.0,
-            corner_angle_deg: 30.0,
-            max_iter: None,
-            parameter_correction: false,
-            newton_iter: 12,
-            batch: true,
-        }
-    }
-}
-
 impl KnotPlacementOptions {
-    /// Sets the degree.
-    pub fn with_degree(mut self, degree: usize) -> Self {
-        self.degree = degree;
-        self
-    }
-    /// Sets whether the curve is closed.
-    pub fn with_closed(mut self, closed: bool) -> Self {
-        self.closed = closed;
-        self
-    }
-    /// Sets the tolerances.
-    pub fn with_tolerances(mut self, tolerances: Tolerances) -> Self {
-        self.tolerances = tolerances;
-        self
-    }
-    /// Sets the standard-deviation bound, %.
-    pub fn with_std_pct(mut self, std_pct: Option<f64>) -> Self {
-        self.std_pct = std_pct;
-        self
-    }
-    /// Sets the second-derivative jump threshold (units of 1 / bbox diagonal).
-    pub fn with_curvature_jump(mut self, jump: f64) -> Self {
-        self.curvature_jump = jump;
-        self
-    }
-    /// Sets the corner angle, degrees.
-    pub fn with_corner_angle_deg(mut self, angle: f64) -> Self {
-        self.corner_angle_deg = angle;
-        self
-    }
-    /// Sets the cap on insertions.
-    pub fn with_max_iter(mut self, max_iter: Option<usize>) -> Self {
-        self.max_iter = max_iter;
-        self
-    }
-    /// Sets whether knots are inserted in every failing span per solve.
-    pub fn with_batch(mut self, batch: bool) -> Self {
-        self.batch = batch;
-        self
-    }
-    /// Sets whether parameters are corrected between solves.
-    pub fn with_parameter_correction(mut self, on: bool) -> Self {
-        self.parameter_correction = on;
-        self
-    }
+    /// The defaults, as each field documents them.
+    pub const DEFAULT: KnotPlacementOptions = KnotPlacementOptions {
+        degree: 3,
+        closed: false,
+        tolerances: Tolerances::DEFAULT,
+        std_pct: None,
+        curvature_jump: 1000.0,
+        corner_angle_deg: 30.0,
+        max_iter: None,
+        parameter_correction: false,
+        newton_iter: 12,
+        batch: true,
+    };
 
-    fn validate(&self) -> Result<(), FitError> {
+    /// Checks every option's range.
+    pub fn validate(&self) -> Result<(), FitError> {
         let bad = |name, reason: String| Err(FitError::InvalidOption { name, reason });
-        if !(1..=MAX_CURVE_DEGREE).contains(&self.degree) {
-            return bad(
-                "degree",
-                format!("{} is not in 1..={MAX_CURVE_DEGREE}", self.degree),
-            );
-        }
+        check_degree(self.degree)?;
         if !(self.curvature_jump.is_finite() && self.curvature_jump > 0.0) {
             return bad(
-                "curvature-jump",
+                "curvatureJump",
                 format!("{} must be positive", self.curvature_jump),
             );
         }
         if !(self.corner_angle_deg > 0.0 && self.corner_angle_deg <= 180.0) {
             return bad(
-                "corner-angle",
+                "cornerAngle",
                 format!("{} is not in (0, 180]", self.corner_angle_deg),
             );
         }
         if let Some(s) = self.std_pct.filter(|s| !(s.is_finite() && *s >= 0.0)) {
-            return bad("tol-std", format!("{s} is not a non-negative percentage"));
+            return bad("tolStd", format!("{s} is not a non-negative percentage"));
         }
-        check_tolerances(&self.tolerances)
+        self.tolerances.validate()
     }
 }
 
+impl Default for KnotPlacementOptions {
+    fn default() -> Self {
+        KnotPlacementOptions::DEFAULT
+    }
+}
+
+setters!(KnotPlacementOptions {
+    /// Sets the standard-deviation bound, %.
+    with_std_pct(std_pct: Option<f64>) => |s| s.std_pct;
+    /// Sets the second-derivative jump threshold (units of 1 / bbox diagonal).
+    with_curvature_jump(curvature_jump: f64) => |s| s.curvature_jump;
+    /// Sets the corner angle, degrees.
+    with_corner_angle_deg(corner_angle_deg: f64) => |s| s.corner_angle_deg;
+    /// Sets the cap on insertions.
+    with_max_iter(max_iter: Option<usize>) => |s| s.max_iter;
+    /// Sets whether knots are inserted in every failing span per solve.
+    with_batch(batch: bool) => |s| s.batch;
+    /// Sets whether parameters are corrected between solves.
+    with_parameter_correction(parameter_correction: bool) => |s| s.parameter_correction;
+});
+
 /// A data point where the shape is not C2: it gets a multiple knot.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Feature {
+pub struct KnotFeature {
     /// Index of the data point.
     pub index: usize,
     /// Its chord-length parameter, the knot value.
@@ -186,7 +157,7 @@ pub(crate) fn detect_features(
     closed: bool,
     degree: usize,
     options: &KnotPlacementOptions,
-) -> Vec<Feature> {
+) -> Vec<KnotFeature> {
     let pts = &data.points;
     let n = pts.len();
     // Arc length along the polyline (unnormalised), so S'' is a curvature vector.
@@ -197,7 +168,7 @@ pub(crate) fn detect_features(
         (len[i] + q * data.length, pts[i])
     };
     let range = if closed { 0..n } else { 3..n.saturating_sub(3) };
-    let mut found: Vec<Feature> = Vec::new();
+    let mut found: Vec<KnotFeature> = Vec::new();
     for i in range {
         let i_s = i as isize;
         let side = |ks: [isize; 4]| {
@@ -219,7 +190,7 @@ pub(crate) fn detect_features(
         let angle_deg = t1.angle_between(t2).to_degrees().min(turn);
         let corner = angle_deg > options.corner_angle_deg;
         if corner || jump > options.curvature_jump {
-            found.push(Feature {
+            found.push(KnotFeature {
                 index: i,
                 param: data.chord[i],
                 multiplicity: if corner { degree } else { (degree - 1).max(1) },
@@ -242,7 +213,7 @@ pub(crate) fn detect_features(
             d
         }
     };
-    let mut kept: Vec<Feature> = Vec::new();
+    let mut kept: Vec<KnotFeature> = Vec::new();
     for f in found {
         if kept.iter().all(|k| gap(k.index, f.index) >= 3) {
             kept.push(f);
@@ -264,7 +235,7 @@ struct Knot {
 pub struct KnotPlacementFitter {
     data: CurveData,
     options: KnotPlacementOptions,
-    features: Vec<Feature>,
+    features: Vec<KnotFeature>,
     /// Interior knots (open) or one period of knots from the seam (closed), sorted.
     knots: Vec<Knot>,
     curve: BSplineCurve,
@@ -273,9 +244,7 @@ pub struct KnotPlacementFitter {
     feet: Vec<f64>,
     errors: Vec<f64>,
     stats: ErrorStats,
-    history: Vec<IterationRecord>,
-    status: FitStatus,
-    initial_control: usize,
+    log: FitLog,
 }
 
 impl KnotPlacementFitter {
@@ -285,6 +254,7 @@ impl KnotPlacementFitter {
         points: &[Point3],
         options: KnotPlacementOptions,
     ) -> Result<KnotPlacementFitter, FitError> {
+        let start = Instant::now();
         options.validate()?;
         let p = options.degree;
         let data = CurveData::try_new(points, options.closed, (2 * p + 2).max(8))?;
@@ -303,7 +273,7 @@ impl KnotPlacementFitter {
         let template = template_curve(&knots, p, options.closed, &data.points)?;
         let curve = least_squares_curve(&template, &data.points, &params)?;
         let mut fitter = KnotPlacementFitter {
-            initial_control: curve.control_points().len(),
+            log: FitLog::new(curve.control_points().len(), start),
             data,
             options,
             features,
@@ -313,12 +283,10 @@ impl KnotPlacementFitter {
             feet: Vec::new(),
             errors: Vec::new(),
             stats: ErrorStats::default(),
-            history: Vec::new(),
-            status: FitStatus::Running,
         };
         fitter.measure();
         if fitter.met() {
-            fitter.status = FitStatus::Converged;
+            fitter.log.stop(FitStatus::Converged);
         }
         Ok(fitter)
     }
@@ -329,28 +297,13 @@ impl KnotPlacementFitter {
     }
 
     /// The detected features (multiple knots).
-    pub fn features(&self) -> &[Feature] {
+    pub fn features(&self) -> &[KnotFeature] {
         &self.features
-    }
-
-    /// The data points.
-    pub fn data(&self) -> &[Point3] {
-        &self.data.points
     }
 
     /// The foot-point parameter of every data point.
     pub fn params(&self) -> &[f64] {
         &self.params
-    }
-
-    /// Control points of the first (features-only) curve.
-    pub fn initial_control_points(&self) -> usize {
-        self.initial_control
-    }
-
-    /// Where the fit stands.
-    pub fn status(&self) -> FitStatus {
-        self.status
     }
 
     /// Standard deviation of the signed normal deviations, % of the bbox diagonal.
@@ -506,14 +459,13 @@ fn template_curve(
 
 impl Fitter for KnotPlacementFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.status != FitStatus::Running {
-            return Ok(self.status);
+        if self.log.status() != FitStatus::Running {
+            return Ok(self.log.status());
         }
         let start = Instant::now();
         let cap = self.options.max_iter.unwrap_or(self.data.points.len());
         if self.insert_knots() == 0 {
-            self.status = FitStatus::MaxIterations;
-            return Ok(self.status);
+            return Ok(self.log.stop(FitStatus::MaxIterations));
         }
         let template = template_curve(
             &self.knots,
@@ -523,28 +475,43 @@ impl Fitter for KnotPlacementFitter {
         )?;
         self.curve = least_squares_curve(&template, &self.data.points, &self.params)?;
         self.measure();
-        let iter = self.history.len() + 1;
-        self.history.push(IterationRecord {
-            iter,
-            control_points: self.curve.control_points().len(),
-            e_avg_pct: self.stats.e_avg_pct,
-            e_max_pct: self.stats.e_max_pct,
-            e_rms_pct: self.stats.e_rms_pct,
-            ms: start.elapsed().as_secs_f64() * 1e3,
-            refined: true,
-        });
-        self.status = if self.met() {
+        let status = if self.met() {
             FitStatus::Converged
-        } else if iter >= cap {
+        } else if self.log.iterations() + 1 >= cap {
             FitStatus::MaxIterations
         } else {
             FitStatus::Running
         };
-        Ok(self.status)
+        let n = self.curve.control_points().len();
+        Ok(self.log.record(start, n, &self.stats, true, status))
     }
 
-    fn history(&self) -> &[IterationRecord] {
-        &self.history
+    fn scheme(&self) -> Scheme {
+        scheme_of(&self.curve)
+    }
+
+    fn method(&self) -> Method {
+        Method::KnotPlacement
+    }
+
+    fn log(&self) -> &FitLog {
+        &self.log
+    }
+
+    fn log_mut(&mut self) -> &mut FitLog {
+        &mut self.log
+    }
+
+    fn tolerances(&self) -> Tolerances {
+        self.options.tolerances
+    }
+
+    fn data(&self) -> &[Point3] {
+        &self.data.points
+    }
+
+    fn diagonal(&self) -> f64 {
+        self.data.diagonal
     }
 
     fn point_errors(&self) -> &[f64] {
@@ -553,5 +520,38 @@ impl Fitter for KnotPlacementFitter {
 
     fn stats(&self) -> ErrorStats {
         self.stats
+    }
+
+    fn foot_points(&self) -> Vec<Point3> {
+        self.feet.iter().map(|&u| self.curve.eval(u)).collect()
+    }
+
+    fn num_control_points(&self) -> usize {
+        self.curve.control_points().len()
+    }
+
+    fn control_shape(&self) -> Shape {
+        control_polygon(&self.curve)
+    }
+
+    fn limit_shape(&self, resolution: usize) -> Shape {
+        curve_shape(&self.curve, resolution)
+    }
+
+    fn spline(&self) -> Option<Spline<'_>> {
+        Some(Spline::Curve(&self.curve))
+    }
+
+    fn details(&self) -> serde_json::Map<String, serde_json::Value> {
+        let mut m = details(&self.curve);
+        let corners = self
+            .features
+            .iter()
+            .filter(|f| f.multiplicity == self.options.degree)
+            .count();
+        m.insert("features".into(), self.features.len().into());
+        m.insert("corners".into(), corners.into());
+        m.insert("std_pct".into(), self.std_pct().into());
+        m
     }
 }

@@ -20,8 +20,8 @@
 //! vertex rule, so where a whole neighbourhood is split the limit surface does not change.
 //! Old vertices keep their indices; edge points and centres follow.
 
-use super::refine::check_manifold;
-use super::FitError;
+use crate::mesh::{check_oriented_edges, TopologyError};
+use crate::subdiv::{Scheme, SubdivError};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use std::cmp::Reverse;
@@ -42,16 +42,15 @@ const TURN: u64 = 2;
 type Quad = [u32; 4];
 
 /// Quads of `mesh`, or an error naming the first face that is not one.
-fn quads_of(mesh: &PolyMesh) -> Result<Vec<Quad>, FitError> {
+fn quads_of(mesh: &PolyMesh) -> Result<Vec<Quad>, SubdivError> {
     mesh.faces()
         .enumerate()
         .map(|(i, f)| match f {
             &[a, b, c, d] => Ok([a, b, c, d]),
-            _ => Err(FitError::ControlMesh {
-                reason: format!(
-                    "face {i} has {} vertices; quad refinement needs quads",
-                    f.len()
-                ),
+            _ => Err(SubdivError::WrongFaceSize {
+                face: i,
+                len: f.len(),
+                scheme: Scheme::CatmullClark,
             }),
         })
         .collect()
@@ -69,7 +68,7 @@ struct QuadEdges {
 }
 
 impl QuadEdges {
-    fn new(quads: &[Quad], nv: usize) -> Result<QuadEdges, FitError> {
+    fn new(quads: &[Quad], nv: usize) -> Result<QuadEdges, SubdivError> {
         let mut index: HashMap<(u32, u32), u32> = HashMap::with_capacity(quads.len() * 2);
         let mut edges = QuadEdges {
             corners: quads.to_vec(),
@@ -92,9 +91,7 @@ impl QuadEdges {
                 } else if edges.faces[id as usize][1] == NO {
                     edges.faces[id as usize][1] = f as u32;
                 } else {
-                    return Err(FitError::ControlMesh {
-                        reason: format!("edge {a}–{b} has more than two faces (face {f})"),
-                    });
+                    return Err(TopologyError::NonManifoldEdge { a, b, faces: 3 }.into());
                 }
                 ids[k] = id;
             }
@@ -125,14 +122,10 @@ impl QuadEdges {
 /// Splits the `marked` quads of `mesh` 1→4 (one flag per face) and closes the split with
 /// transition templates so the mesh stays all-quad, conforming and consistently oriented.
 /// New points come from Catmull–Clark's masks (see the module docs).
-pub fn split_quads(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
+pub fn split_quads(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, SubdivError> {
     let quads = quads_of(mesh)?;
-    if marked.len() != quads.len() {
-        return Err(FitError::ControlMesh {
-            reason: format!("{} face flags for {} faces", marked.len(), quads.len()),
-        });
-    }
-    check_manifold(mesh)?;
+    super::check_flags(marked, quads.len())?;
+    check_oriented_edges(mesh)?;
     let edges = QuadEdges::new(&quads, mesh.num_vertices())?;
     let split = close_split(&quads, &edges, marked);
     let counts = edges.counts(&split);
@@ -147,21 +140,19 @@ pub fn split_quads(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitErro
             [f0, f1] if f1 != NO => (mid + centroid(f0 as usize) + centroid(f1 as usize)) * 0.25,
             _ => mid * 0.5,
         };
-        edge_point[e] = index_u32(positions.len())?;
+        edge_point[e] = super::index_u32(positions.len())?;
         positions.push(p);
     }
     let mut faces = Vec::with_capacity(quads.len() + 3 * edge_point.len());
     for (f, q) in quads.iter().enumerate() {
         let m = edges.of_face[f].map(|e| edge_point[e as usize]);
-        let centre = || -> Result<u32, FitError> {
+        let centre = || -> Result<u32, SubdivError> {
             positions.push(centroid(f));
-            index_u32(positions.len() - 1)
+            super::index_u32(positions.len() - 1)
         };
         template(q, m, centre, &mut faces)?;
     }
-    PolyMesh::try_new(positions, faces).map_err(|e| FitError::ControlMesh {
-        reason: e.to_string(),
-    })
+    Ok(PolyMesh::try_new(positions, faces)?)
 }
 
 /// Appends the quads that replace `q`, whose edge points are `m` (`NO` where an edge is not
@@ -169,9 +160,9 @@ pub fn split_quads(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitErro
 fn template(
     q: &Quad,
     m: [u32; 4],
-    mut centre: impl FnMut() -> Result<u32, FitError>,
+    mut centre: impl FnMut() -> Result<u32, SubdivError>,
     out: &mut Vec<Quad>,
-) -> Result<(), FitError> {
+) -> Result<(), SubdivError> {
     let s = m.map(|p| p != NO);
     let k = |i: usize| i % 4;
     match s.iter().filter(|&&x| x).count() {
@@ -202,16 +193,10 @@ fn template(
 }
 
 /// Internal consistency error: the closure left a quad with an odd number of split edges.
-fn odd_count(q: &Quad) -> FitError {
-    FitError::ControlMesh {
-        reason: format!("quad {q:?} has an odd number of split edges after closure"),
+fn odd_count(q: &Quad) -> SubdivError {
+    SubdivError::Internal {
+        what: format!("quad {q:?} has an odd number of split edges after closure"),
     }
-}
-
-fn index_u32(n: usize) -> Result<u32, FitError> {
-    u32::try_from(n).map_err(|_| FitError::ControlMesh {
-        reason: "more than u32::MAX control points".into(),
-    })
 }
 
 /// The edges to split: every edge of a marked quad, then what gives every quad an even count:
@@ -426,7 +411,7 @@ mod tests {
         let mut marked = vec![false; 25];
         marked[12] = true;
         let m = split_quads(&g, &marked).expect("split");
-        check_manifold(&m).expect("manifold");
+        check_oriented_edges(&m).expect("manifold");
         assert!(m.faces().all(|f| f.len() == 4));
         // Planar and every new point inside its old face: the area is kept, nothing flips.
         assert!((area(&m) - 25.0).abs() < 1e-12);

@@ -6,7 +6,7 @@
 //! does not jump. Remeshing flips edges that lower the valence energy
 //! R(M) = Σ (d(v) − d_opt(v))² or remove long thin triangles, never folding a triangle over.
 
-use super::FitError;
+use crate::subdiv::{Scheme, SubdivError};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::PolyMesh;
 use std::collections::{BTreeMap, HashMap};
@@ -29,16 +29,15 @@ fn edge(a: u32, b: u32) -> Edge {
 }
 
 /// Triangles of `mesh`, or an error naming the first face that is not one.
-pub fn triangles_of(mesh: &PolyMesh) -> Result<Vec<[u32; 3]>, FitError> {
+pub fn triangles_of(mesh: &PolyMesh) -> Result<Vec<[u32; 3]>, SubdivError> {
     mesh.faces()
         .enumerate()
-        .map(|(i, f)| match f {
+        .map(|(face, f)| match f {
             &[a, b, c] => Ok([a, b, c]),
-            _ => Err(FitError::ControlMesh {
-                reason: format!(
-                    "face {i} has {} vertices; a Loop mesh needs triangles",
-                    f.len()
-                ),
+            _ => Err(SubdivError::WrongFaceSize {
+                face,
+                len: f.len(),
+                scheme: Scheme::Loop,
             }),
         })
         .collect()
@@ -64,13 +63,9 @@ pub fn split_triangles(
     mesh: &PolyMesh,
     marked: &[bool],
     rule: SplitRule,
-) -> Result<PolyMesh, FitError> {
+) -> Result<PolyMesh, SubdivError> {
     let tris = triangles_of(mesh)?;
-    if marked.len() != tris.len() {
-        return Err(FitError::ControlMesh {
-            reason: format!("{} face flags for {} faces", marked.len(), tris.len()),
-        });
-    }
+    super::check_flags(marked, tris.len())?;
     let faces_on = edge_faces(&tris);
     let red = close_red_set(&tris, marked, &faces_on);
     let pos = mesh.positions();
@@ -84,7 +79,7 @@ pub fn split_triangles(
                 continue;
             }
             let p = edge_point(pos, e, &faces_on[&e], rule);
-            mid.insert(e, index_u32(positions.len())?);
+            mid.insert(e, super::index_u32(positions.len())?);
             positions.push(p);
         }
     }
@@ -108,15 +103,7 @@ pub fn split_triangles(
             _ => faces.push([a, b, c]),
         }
     }
-    PolyMesh::try_new(positions, faces).map_err(|e| FitError::ControlMesh {
-        reason: e.to_string(),
-    })
-}
-
-fn index_u32(n: usize) -> Result<u32, FitError> {
-    u32::try_from(n).map_err(|_| FitError::ControlMesh {
-        reason: "more than u32::MAX control points".into(),
-    })
+    Ok(PolyMesh::try_new(positions, faces)?)
 }
 
 /// The marked faces plus every face that would otherwise get two or three split edges.
@@ -198,22 +185,12 @@ fn move_old_vertices(
         out[v] = match (boundary[v].as_slice(), ring[v].len()) {
             (&[a, b], _) => p * 0.75 + (pos[a as usize] + pos[b as usize]) * 0.125,
             ([], k) if k >= 3 => {
-                let beta = loop_beta(k);
+                let beta = crate::subdiv::topo::loop_beta(k);
                 let sum: Vec3 = ring[v].iter().map(|&w| pos[w as usize]).sum();
                 p * (1.0 - k as f64 * beta) + sum * beta
             }
             _ => p,
         };
-    }
-}
-
-/// Loop's vertex weight in Warren's form, 3/16 for valence 3 and 3/(8k) otherwise: the rule the
-/// subdivision library refines and evaluates with, so a split reproduces its limit surface.
-fn loop_beta(k: usize) -> f64 {
-    if k == 3 {
-        3.0 / 16.0
-    } else {
-        3.0 / (8.0 * k as f64)
     }
 }
 
@@ -232,7 +209,7 @@ pub fn improve_by_flips(
     mesh: &mut PolyMesh,
     passes: usize,
     first_new: u32,
-) -> Result<usize, FitError> {
+) -> Result<usize, SubdivError> {
     let mut tris = triangles_of(mesh)?;
     let pos = mesh.positions().to_vec();
     let mut total = 0;
@@ -244,9 +221,7 @@ pub fn improve_by_flips(
         }
     }
     if total > 0 {
-        *mesh = PolyMesh::try_new(pos, tris).map_err(|e| FitError::ControlMesh {
-            reason: e.to_string(),
-        })?;
+        *mesh = PolyMesh::try_new(pos, tris)?;
     }
     Ok(total)
 }
@@ -354,28 +329,6 @@ fn flip_keeps_shape(pos: &[Point3], old: [[u32; 3]; 2], new: [[u32; 3]; 2]) -> b
     n1.dot(n2) > 30f64.to_radians().cos() && m1.dot(avg) > 0.5 && m2.dot(avg) > 0.5
 }
 
-/// Checks that every edge has one or two faces and that the two faces on an edge use it in
-/// opposite directions (a consistently oriented manifold with boundary).
-pub fn check_manifold(mesh: &PolyMesh) -> Result<(), FitError> {
-    let mut directed: HashMap<Edge, usize> = HashMap::new();
-    for (i, f) in mesh.faces().enumerate() {
-        for k in 0..f.len() {
-            let (a, b) = (f[k], f[(k + 1) % f.len()]);
-            if a == b {
-                return Err(FitError::ControlMesh {
-                    reason: format!("face {i} repeats vertex {a}"),
-                });
-            }
-            if directed.insert((a, b), i).is_some() {
-                return Err(FitError::ControlMesh {
-                    reason: format!("edge {a}→{b} is used twice in one direction (face {i})"),
-                });
-            }
-        }
-    }
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -396,18 +349,13 @@ mod tests {
         // 1→4 plus the neighbour 1→2, one new point per edge of the red face.
         assert_eq!(m.num_faces(), 6);
         assert_eq!(m.num_vertices(), 7);
-        check_manifold(&m).expect("manifold");
+        crate::mesh::check_oriented_edges(&m).expect("manifold");
         let area: f64 = m
             .triangles()
             .iter()
             .map(|&t| normal(m.positions(), t).length() * 0.5)
             .sum();
         assert!((area - 1.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn loop_beta_regular_is_one_sixteenth() {
-        assert!((loop_beta(6) - 1.0 / 16.0).abs() < 1e-15);
     }
 
     #[test]
@@ -421,7 +369,7 @@ mod tests {
         let mut m = PolyMesh::try_new(p, [[0, 1, 2], [1, 0, 3]]).expect("valid");
         assert_eq!(improve_by_flips(&mut m, 3, 4).expect("none new"), 0);
         assert_eq!(improve_by_flips(&mut m, 3, 3).expect("flips"), 1);
-        check_manifold(&m).expect("manifold");
+        crate::mesh::check_oriented_edges(&m).expect("manifold");
         assert!(m.faces().all(|f| f.contains(&2) && f.contains(&3)));
     }
 }

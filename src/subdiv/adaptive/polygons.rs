@@ -6,8 +6,8 @@
 //! new points are the centroid and the edge midpoints of the control polygon; the centroid of
 //! a face is a point of the Doo–Sabin limit surface (face centroids are kept by every step).
 
-use super::refine::check_manifold;
-use super::FitError;
+use crate::mesh::check_oriented_edges;
+use crate::subdiv::SubdivError;
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use std::collections::HashMap;
@@ -15,20 +15,12 @@ use std::collections::HashMap;
 /// Splits the `marked` faces of `mesh` (one flag per face) into quads around their centroids
 /// and inserts the new edge midpoints into the unmarked neighbours. Old vertices keep their
 /// indices; midpoints and centroids follow.
-pub fn split_polygons(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
-    if marked.len() != mesh.num_faces() {
-        return Err(FitError::ControlMesh {
-            reason: format!("{} face flags for {} faces", marked.len(), mesh.num_faces()),
-        });
-    }
+pub fn split_polygons(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, SubdivError> {
+    super::check_flags(marked, mesh.num_faces())?;
     let pos = mesh.positions();
     let mut positions = pos.to_vec();
     let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-    let index = |n: usize| {
-        u32::try_from(n).map_err(|_| FitError::ControlMesh {
-            reason: "more than u32::MAX control points".into(),
-        })
-    };
+    let index = super::index_u32;
     for (f, face) in mesh.faces().enumerate() {
         if !marked[f] {
             continue;
@@ -68,10 +60,8 @@ pub fn split_polygons(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitE
             faces.push(out);
         }
     }
-    let out = PolyMesh::try_new(positions, faces).map_err(|e| FitError::ControlMesh {
-        reason: e.to_string(),
-    })?;
-    check_manifold(&out)?;
+    let out = PolyMesh::try_new(positions, faces)?;
+    check_oriented_edges(&out)?;
     Ok(out)
 }
 

@@ -7,41 +7,34 @@
 //! the worst patches (the surface is unchanged by insertion, so the fit continues from where it
 //! was).
 
-use super::accel::Accelerator;
-use super::lsq_surface::{
-    check_common, check_early_split_share, plane_surface, LsqSurfaceFitter, LsqSurfaceOptions,
+use super::parameterize::{check_points, parameterize, Parameterization};
+use super::patches::{correct_parameters, failing_share, patch_errors, split_worst, PatchGrid};
+use super::{
+    check_early_split_share, control_grid, details, iso_lines, plane_surface, surface_feet,
+    surface_mesh, LsqSurfaceFitter, LsqSurfaceOptions, SurfaceGrid,
 };
-use super::options::Acceleration;
-use super::parameterize::{check_points, parameterize, ParamOptions, Parameterization};
-use super::patches::{
-    correct_parameters, failing_share, patch_errors, split_worst, Criterion, PatchGrid, TolMode,
+use crate::fit::accel::Accelerator;
+use crate::fit::{
+    Acceleration, ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline,
+    Tolerances,
 };
-use super::{ErrorStats, FitError, FitStatus, Fitter, IterationRecord};
 use crate::geom::{Aabb, Point3, Vec3};
 use crate::spline::BSplineSurface;
 use web_time::Instant;
 
-/// Options of [`GeometricSurfaceFitter`].
+/// Options of [`GeometricSurfaceFitter`]. Defaults in brackets on each field.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[non_exhaustive]
 pub struct GeometricSurfaceOptions {
-    /// Degree in u and v. Default 3.
-    pub degree: usize,
-    /// Initial control points (u, v). Default (8, 8).
-    pub control: (usize, usize),
-    /// Keep the knots fixed. Default false.
-    pub fixed_knots: bool,
-    /// Tolerance TOL, % of the bounding-box diagonal. Default 0.1.
-    pub tol_pct: f64,
-    /// How patches are judged against TOL. Default [`TolMode::Noisy`].
-    pub tol_mode: TolMode,
-    /// Acceleration of the control-point moves. Default Anderson with depth 5.
+    /// The control grid, its splitting and the tolerance, shared with least squares.
+    pub grid: SurfaceGrid,
+    /// Acceleration of the control-point moves [[`Acceleration::ANDERSON`]].
     pub acceleration: Acceleration,
     /// Iterations on one knot vector before refining, unless the error stalls earlier
-    /// (relative E_rms gain under 1 %). Default 12.
+    /// (relative E_rms gain under 1 %) [12].
     pub iterations_per_knots: usize,
     /// Refine after this many iterations on a knot vector while more than `early_split_share`
-    /// of the patches holding points miss TOL. Default 4.
+    /// of the patches holding points miss TOL [4].
     ///
     /// Why: an iteration costs about the same on any knot vector (its work is per data point),
     /// so iterating a coarse surface that must be split anyway is the dearest way to lower the
@@ -49,80 +42,41 @@ pub struct GeometricSurfaceOptions {
     /// instead of 64 and 10,440; at tol 0.05 % E_max 0.083 % instead of 0.123 % when both stop
     /// at the 40,000 cap.
     pub early_split_after: usize,
-    /// See `early_split_after`. Default 0.5.
+    /// See `early_split_after` [0.5].
     pub early_split_share: f64,
-    /// Cap on the control-point count. Default 40,000.
-    pub max_control_points: usize,
-    /// In [`TolMode::Noisy`], a patch with fewer points than this is judged on the points of
-    /// its 3 × 3 patch neighbourhood. Default 16.
-    pub min_sample: usize,
-    /// Iteration cap. Default 200.
+    /// Iteration cap [200].
     pub max_iterations: usize,
-    /// Newton iterations per point and iteration (warm-started). Default 3.
+    /// Newton iterations per point and iteration (warm-started) [3].
     pub newton_iterations: usize,
-    /// How the initial parameters are found.
-    pub param: ParamOptions,
     /// Start from one smoothed least-squares solve ([`LsqSurfaceFitter`] with its default
     /// weights, then a parameter correction) instead of the flat control net over the
-    /// projection plane. The error-vector iteration converges linearly from wherever it
-    /// starts; from the flat net most of its iterations only lift the net onto the data, which
-    /// one sparse solve does at the cost of about one iteration — worth it on fixed knots
+    /// projection plane [false]. The error-vector iteration converges linearly from wherever
+    /// it starts; from the flat net most of its iterations only lift the net onto the data,
+    /// which one sparse solve does at the cost of about one iteration — worth it on fixed knots
     /// (bun000.ply, 400 control points: E_max 1.56 % after 3 iterations instead of 4.5 %).
     /// With adaptive splitting it is not: the warm fit's gains fall under the stall threshold
     /// sooner, so it splits earlier and ends with more control points (tol 0.1 %: 18,850
-    /// instead of 10,350). Default false.
+    /// instead of 10,350).
     pub warm_start: bool,
 }
 
-impl Default for GeometricSurfaceOptions {
-    fn default() -> Self {
-        GeometricSurfaceOptions {
-            degree: 3,
-            control: (8, 8),
-            fixed_knots: false,
-            tol_pct: 0.1,
-            tol_mode: TolMode::Noisy,
-            acceleration: Acceleration::Anderson { depth: 5 },
-            iterations_per_knots: 12,
-            early_split_after: 4,
-            early_split_share: 0.5,
-            max_control_points: 40_000,
-            min_sample: 16,
-            max_iterations: 200,
-            newton_iterations: 3,
-            param: ParamOptions::default(),
-            warm_start: false,
-        }
-    }
-}
-
 impl GeometricSurfaceOptions {
-    /// Sets the degree.
-    pub fn with_degree(mut self, degree: usize) -> Self {
-        self.degree = degree;
-        self
+    /// The defaults, as each field documents them.
+    pub const DEFAULT: GeometricSurfaceOptions = GeometricSurfaceOptions {
+        grid: SurfaceGrid::DEFAULT,
+        acceleration: Acceleration::ANDERSON,
+        iterations_per_knots: 12,
+        early_split_after: 4,
+        early_split_share: 0.5,
+        max_iterations: 200,
+        newton_iterations: 3,
+        warm_start: false,
+    };
+
+    pub(crate) fn grid_mut(&mut self) -> &mut SurfaceGrid {
+        &mut self.grid
     }
-    /// Sets the initial control-point counts.
-    pub fn with_control(mut self, nu: usize, nv: usize) -> Self {
-        self.control = (nu, nv);
-        self
-    }
-    /// Keeps the knots fixed.
-    pub fn with_fixed_knots(mut self, fixed: bool) -> Self {
-        self.fixed_knots = fixed;
-        self
-    }
-    /// Sets the tolerance (%) and its mode.
-    pub fn with_tolerance(mut self, tol_pct: f64, mode: TolMode) -> Self {
-        self.tol_pct = tol_pct;
-        self.tol_mode = mode;
-        self
-    }
-    /// Sets the acceleration.
-    pub fn with_acceleration(mut self, acceleration: Acceleration) -> Self {
-        self.acceleration = acceleration;
-        self
-    }
+
     /// Sets when a knot vector is split early: after `iterations` while more than `share` of
     /// the patches fail.
     pub fn with_early_split(mut self, iterations: usize, share: f64) -> Self {
@@ -130,27 +84,29 @@ impl GeometricSurfaceOptions {
         self.early_split_share = share;
         self
     }
-    /// Sets the iteration cap.
-    pub fn with_max_iterations(mut self, n: usize) -> Self {
-        self.max_iterations = n;
-        self
-    }
-    /// Sets the cap on control points.
-    pub fn with_max_control_points(mut self, n: usize) -> Self {
-        self.max_control_points = n;
-        self
-    }
-    /// Sets the parameterisation options.
-    pub fn with_param(mut self, param: ParamOptions) -> Self {
-        self.param = param;
-        self
-    }
-    /// Starts from a least-squares solve (true) or from the flat control net (false).
-    pub fn with_warm_start(mut self, warm: bool) -> Self {
-        self.warm_start = warm;
-        self
+
+    /// Checks every option's range.
+    pub fn validate(&self) -> Result<(), FitError> {
+        self.grid.validate()?;
+        self.acceleration.validate()?;
+        check_early_split_share(self.early_split_share)
     }
 }
+
+impl Default for GeometricSurfaceOptions {
+    fn default() -> Self {
+        GeometricSurfaceOptions::DEFAULT
+    }
+}
+
+setters!(GeometricSurfaceOptions {
+    /// Sets the acceleration.
+    with_acceleration(acceleration: Acceleration) => |s| s.acceleration;
+    /// Sets the iteration cap.
+    with_max_iterations(max_iterations: usize) => |s| s.max_iterations;
+    /// Starts from a least-squares solve (true) or from the flat control net (false).
+    with_warm_start(warm_start: bool) => |s| s.warm_start;
+});
 
 /// Geometric (error-vector) B-spline surface fitter, driven through [`Fitter`].
 pub struct GeometricSurfaceFitter {
@@ -162,12 +118,9 @@ pub struct GeometricSurfaceFitter {
     surface: BSplineSurface,
     opts: GeometricSurfaceOptions,
     diagonal: f64,
-    history: Vec<IterationRecord>,
+    log: FitLog,
     accel: Accelerator,
     iters_at_knots: usize,
-    initial_control: usize,
-    precompute_s: f64,
-    status: FitStatus,
 }
 
 impl GeometricSurfaceFitter {
@@ -175,21 +128,13 @@ impl GeometricSurfaceFitter {
     /// starts from the flat control net over the projection plane.
     pub fn try_new(points: &[Point3], opts: GeometricSurfaceOptions) -> Result<Self, FitError> {
         let start = Instant::now();
-        check_common(opts.degree, opts.control, opts.tol_pct)?;
-        if let Acceleration::Anderson { depth } = opts.acceleration {
-            if !(1..=20).contains(&depth) {
-                return Err(FitError::InvalidOption {
-                    name: "anderson depth",
-                    reason: format!("{depth} is outside 1..=20"),
-                });
-            }
-        }
-        check_early_split_share(opts.early_split_share)?;
-        check_points(points, opts.degree + 1)?;
-        let mut param = parameterize(points, &opts.param)?;
-        let mut surface = plane_surface(&param, opts.degree, opts.control)?;
+        opts.validate()?;
+        let g = opts.grid;
+        check_points(points, g.degree + 1)?;
+        let mut param = parameterize(points, &g.param)?;
+        let mut surface = plane_surface(&param, g.degree, g.control)?;
         let active: Vec<bool> = (0..points.len())
-            .map(|i| param.is_active(i, opts.param.fold_policy))
+            .map(|i| param.is_active(i, g.param.fold_policy))
             .collect();
         if opts.warm_start {
             (surface, param.uv) = least_squares_start(points, param.clone(), surface, &opts)?;
@@ -201,18 +146,15 @@ impl GeometricSurfaceFitter {
             dist: vec![0.0; points.len()],
             num_folded: param.num_folded,
             uv: param.uv,
-            initial_control: opts.control.0 * opts.control.1,
+            log: FitLog::new(g.control.0 * g.control.1, start),
             surface,
             opts,
             diagonal,
-            history: Vec::new(),
             accel: Accelerator::new(opts.acceleration),
             iters_at_knots: 0,
-            precompute_s: 0.0,
-            status: FitStatus::Running,
         };
         fitter.foot_points();
-        fitter.precompute_s = start.elapsed().as_secs_f64();
+        fitter.log = FitLog::new(g.control.0 * g.control.1, start);
         Ok(fitter)
     }
 
@@ -229,21 +171,6 @@ impl GeometricSurfaceFitter {
     /// The foot-point parameters (u, v) of every data point, in data order.
     pub fn parameters(&self) -> &[[f64; 2]] {
         &self.uv
-    }
-
-    /// Control points at the start.
-    pub fn initial_control_points(&self) -> usize {
-        self.initial_control
-    }
-
-    /// Seconds spent in set-up (checks, parameterisation, first foot points).
-    pub fn precompute_seconds(&self) -> f64 {
-        self.precompute_s
-    }
-
-    /// The status after the last step.
-    pub fn status(&self) -> FitStatus {
-        self.status
     }
 
     fn foot_points(&mut self) {
@@ -331,13 +258,11 @@ fn least_squares_start(
     surface: BSplineSurface,
     opts: &GeometricSurfaceOptions,
 ) -> Result<(BSplineSurface, Vec<[f64; 2]>), FitError> {
-    let lsq = LsqSurfaceOptions::default()
-        .with_degree(opts.degree)
-        .with_control(opts.control.0, opts.control.1)
-        .with_fixed_knots(true)
-        .with_solves_per_knots(1)
-        .with_tolerance(opts.tol_pct, opts.tol_mode)
-        .with_param(opts.param);
+    let lsq = LsqSurfaceOptions {
+        grid: opts.grid.with_fixed_knots(true),
+        solves_per_knots: 1,
+        ..LsqSurfaceOptions::DEFAULT
+    };
     let mut fitter = LsqSurfaceFitter::with_parameters(points, param, surface, lsq)?;
     fitter.step()?;
     Ok((fitter.surface().clone(), fitter.parameters().to_vec()))
@@ -349,39 +274,34 @@ fn plain_step(x: &[Point3], d: &[Vec3]) -> Vec<Point3> {
 
 impl Fitter for GeometricSurfaceFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.status != FitStatus::Running {
-            return Ok(self.status);
+        if self.log.status() != FitStatus::Running {
+            return Ok(self.log.status());
         }
         let start = Instant::now();
         let rms_before = self.stats().e_rms;
         self.move_control_points()?;
         self.iters_at_knots += 1;
         let grid = PatchGrid::of(&self.surface);
-        let tol = self.opts.tol_pct / 100.0 * self.diagonal;
         let errors = patch_errors(
             &self.surface,
             &grid,
             &self.uv,
             &self.dist,
             &self.active,
-            Criterion {
-                tol,
-                mode: self.opts.tol_mode,
-                min_sample: self.opts.min_sample,
-            },
+            self.opts.grid.criterion(self.diagonal),
         );
         let stalled = self.stats().e_rms > 0.99 * rms_before;
         let split_early = self.iters_at_knots >= self.opts.early_split_after
             && failing_share(&errors) > self.opts.early_split_share;
         let due = stalled || split_early || self.iters_at_knots >= self.opts.iterations_per_knots;
         let mut refined = false;
-        self.status = if errors.iter().all(|e| e.pass) {
+        let status = if errors.iter().all(|e| e.pass) {
             FitStatus::Converged
-        } else if self.history.len() + 1 >= self.opts.max_iterations {
+        } else if self.log.iterations() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
         } else if !due {
             FitStatus::Running
-        } else if self.opts.fixed_knots {
+        } else if self.opts.grid.fixed_knots {
             if stalled {
                 FitStatus::MaxIterations
             } else {
@@ -392,7 +312,7 @@ impl Fitter for GeometricSurfaceFitter {
                 &mut self.surface,
                 &grid,
                 &errors,
-                self.opts.max_control_points,
+                self.opts.grid.max_control_points,
                 f64::INFINITY,
             );
             refined = inserted > 0;
@@ -404,22 +324,37 @@ impl Fitter for GeometricSurfaceFitter {
                 FitStatus::MaxIterations
             }
         };
-        let stats = self.stats();
         let (nu, nv) = self.surface.num_control();
-        self.history.push(IterationRecord {
-            iter: self.history.len() + 1,
-            control_points: nu * nv,
-            e_avg_pct: stats.e_avg_pct,
-            e_max_pct: stats.e_max_pct,
-            e_rms_pct: stats.e_rms_pct,
-            ms: start.elapsed().as_secs_f64() * 1e3,
-            refined,
-        });
-        Ok(self.status)
+        let stats = self.stats();
+        Ok(self.log.record(start, nu * nv, &stats, refined, status))
     }
 
-    fn history(&self) -> &[IterationRecord] {
-        &self.history
+    fn scheme(&self) -> Scheme {
+        Scheme::BsplineSurface
+    }
+
+    fn method(&self) -> Method {
+        Method::Geometric
+    }
+
+    fn log(&self) -> &FitLog {
+        &self.log
+    }
+
+    fn log_mut(&mut self) -> &mut FitLog {
+        &mut self.log
+    }
+
+    fn tolerances(&self) -> Tolerances {
+        Tolerances::max_only(self.opts.grid.tol_pct)
+    }
+
+    fn data(&self) -> &[Point3] {
+        &self.points
+    }
+
+    fn diagonal(&self) -> f64 {
+        self.diagonal
     }
 
     fn point_errors(&self) -> &[f64] {
@@ -428,5 +363,33 @@ impl Fitter for GeometricSurfaceFitter {
 
     fn stats(&self) -> ErrorStats {
         ErrorStats::from_distances(&self.dist, self.diagonal)
+    }
+
+    fn foot_points(&self) -> Vec<Point3> {
+        surface_feet(&self.surface, &self.uv)
+    }
+
+    fn num_control_points(&self) -> usize {
+        self.surface.control_points().len()
+    }
+
+    fn control_shape(&self) -> Shape {
+        control_grid(&self.surface)
+    }
+
+    fn limit_shape(&self, resolution: usize) -> Shape {
+        surface_mesh(&self.surface, resolution)
+    }
+
+    fn iso_lines(&self, resolution: usize) -> Vec<Point3> {
+        iso_lines(&self.surface, resolution)
+    }
+
+    fn spline(&self) -> Option<Spline<'_>> {
+        Some(Spline::Surface(&self.surface))
+    }
+
+    fn details(&self) -> serde_json::Map<String, serde_json::Value> {
+        details(&self.surface, self.num_folded)
     }
 }

@@ -3,12 +3,11 @@
 //! splitting by knot insertion, and parameter correction (re-projection by Newton).
 
 use crate::geom::Point3;
-use crate::spline::{BSplineSurface, KnotVector, NewtonOptions};
-use serde::{Deserialize, Serialize};
+use crate::geom::{ClosestPoint, NewtonOptions};
+use crate::spline::{BSplineSurface, KnotVector};
 
 /// How a patch is judged against the tolerance TOL (SPEC §2).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum TolMode {
     /// Noise-free data: ERR = largest distance of the patch's points; passes if ERR ≤ TOL.
     Exact,
@@ -18,6 +17,8 @@ pub enum TolMode {
     #[default]
     Noisy,
 }
+
+named_enum!(TolMode, "tolMode", { Exact => "exact", Noisy => "noisy" });
 
 /// Share of a patch's points that must lie within TOL in [`TolMode::Noisy`].
 const NOISY_INLIER_SHARE: f64 = 0.95;
@@ -291,18 +292,18 @@ pub(crate) fn correct_parameters(
     dist: &mut [f64],
     iterations: usize,
 ) {
-    let opts = NewtonOptions::default()
-        .with_max_iterations(iterations)
-        .with_param_tolerance(1e-7);
+    let opts = NewtonOptions::DEFAULT
+        .with_max_iter(iterations)
+        .with_step_tol(1e-7);
     // Each point's foot point depends on that point alone: the same result on any number of
     // threads.
-    super::parallel::zip_chunks(points, uv, dist, |points, uv, dist| {
+    crate::fit::parallel::zip_chunks(points, uv, dist, |points, uv, dist| {
         for ((p, t), d) in points.iter().zip(uv.iter_mut()).zip(dist.iter_mut()) {
-            let near = surface.closest_point(*p, t[0], t[1], opts);
-            *t = [near.u, near.v];
+            let near = surface.closest_point_from(*p, *t, &opts);
+            *t = near.param;
             let e = *p - near.point;
             let len = e.length();
-            *d = if e.dot(near.normal) < 0.0 { -len } else { len };
+            *d = if e.dot(near.direction) < 0.0 { -len } else { len };
         }
     });
 }

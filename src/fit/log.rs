@@ -1,0 +1,107 @@
+//! The bookkeeping every engine shares: one record per iteration, the status, the set-up time
+//! and what happened to the data on intake.
+
+use super::{ErrorStats, FitStatus, IterationRecord, ReconstructionReport};
+use web_time::Instant;
+
+/// History and status of a fit, kept the same way by every engine.
+#[derive(Clone, Debug)]
+pub struct FitLog {
+    history: Vec<IterationRecord>,
+    status: FitStatus,
+    initial_control: usize,
+    precompute_s: f64,
+    fit_s: f64,
+    reconstruction: Option<ReconstructionReport>,
+}
+
+impl FitLog {
+    /// A log of a fit that starts with `initial_control` control points, set up since `start`.
+    pub(crate) fn new(initial_control: usize, start: Instant) -> FitLog {
+        FitLog {
+            history: Vec::new(),
+            status: FitStatus::Running,
+            initial_control,
+            precompute_s: start.elapsed().as_secs_f64(),
+            fit_s: 0.0,
+            reconstruction: None,
+        }
+    }
+
+    /// Closes the iteration that began at `start`: records its figures and sets the status.
+    /// Returns the status.
+    pub(crate) fn record(
+        &mut self,
+        start: Instant,
+        control_points: usize,
+        stats: &ErrorStats,
+        refined: bool,
+        status: FitStatus,
+    ) -> FitStatus {
+        let seconds = start.elapsed().as_secs_f64();
+        self.fit_s += seconds;
+        self.history.push(IterationRecord {
+            iter: self.history.len() + 1,
+            control_points,
+            e_avg_pct: stats.e_avg_pct,
+            e_max_pct: stats.e_max_pct,
+            e_rms_pct: stats.e_rms_pct,
+            ms: seconds * 1e3,
+            refined,
+        });
+        self.status = status;
+        status
+    }
+
+    /// Sets the status without an iteration (a fit found converged or stuck before moving).
+    pub(crate) fn stop(&mut self, status: FitStatus) -> FitStatus {
+        self.status = status;
+        status
+    }
+
+    /// One record per iteration so far.
+    pub fn history(&self) -> &[IterationRecord] {
+        &self.history
+    }
+
+    /// Iterations run so far.
+    pub fn iterations(&self) -> usize {
+        self.history.len()
+    }
+
+    /// Where the fit stands.
+    pub fn status(&self) -> FitStatus {
+        self.status
+    }
+
+    /// Control points at the start.
+    pub fn initial_control_points(&self) -> usize {
+        self.initial_control
+    }
+
+    /// Seconds of set-up before the first iteration: the engine's own (parameters, spatial
+    /// index, first foot points) and what builders added ([`FitLog::add_precompute`]).
+    pub fn precompute_seconds(&self) -> f64 {
+        self.precompute_s
+    }
+
+    /// Seconds spent in iterations so far.
+    pub fn fit_seconds(&self) -> f64 {
+        self.fit_s
+    }
+
+    /// Adds set-up time spent before the engine existed (reading, meshing, simplification).
+    pub fn add_precompute(&mut self, seconds: f64) {
+        self.precompute_s += seconds.max(0.0);
+    }
+
+    /// How bare points were meshed before the fit, when they were.
+    pub fn reconstruction(&self) -> Option<&ReconstructionReport> {
+        self.reconstruction.as_ref()
+    }
+
+    /// Records how bare points were meshed before the fit.
+    pub fn set_reconstruction(&mut self, report: Option<ReconstructionReport>) {
+        self.reconstruction = report;
+    }
+}

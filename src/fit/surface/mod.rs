@@ -1,0 +1,268 @@
+//! Fitting one tensor-product B-spline surface to a scan: by error vectors
+//! ([`GeometricSurfaceFitter`], SPEC §1 applied to B-splines) or by smoothed least squares
+//! ([`LsqSurfaceFitter`], SPEC §2). Both share the grid they start from and split
+//! ([`SurfaceGrid`]), the parameterisation, the per-patch tolerance test and the drawable
+//! shapes here.
+
+mod geometric;
+mod least_squares;
+mod normal_system;
+mod parameterize;
+mod patches;
+
+pub use geometric::{GeometricSurfaceFitter, GeometricSurfaceOptions};
+pub use least_squares::{energies, LsqSurfaceFitter, LsqSurfaceOptions};
+pub use parameterize::{
+    parameterize, parameterize_on_surface, FoldPolicy, ParamOptions, Parameterization,
+};
+pub use patches::TolMode;
+
+use super::{FitError, Shape};
+use crate::geom::Point3;
+use crate::mesh::PolyMesh;
+use crate::spline::{BSplineSurface, KnotVector, SplineError, MAX_DEGREE};
+use patches::Criterion;
+
+/// What both surface methods share: the control grid they start from, how far they may split
+/// it, and how a patch is judged against the tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct SurfaceGrid {
+    /// Degree in u and v [3].
+    pub degree: usize,
+    /// Initial control points (u, v) [(8, 8)].
+    pub control: (usize, usize),
+    /// Keep the knots fixed: no patch splitting [false].
+    pub fixed_knots: bool,
+    /// Tolerance TOL, % of the bounding-box diagonal [0.1].
+    pub tol_pct: f64,
+    /// How patches are judged against TOL [[`TolMode::Noisy`]].
+    pub tol_mode: TolMode,
+    /// Cap on the control-point count when splitting [40,000].
+    pub max_control_points: usize,
+    /// In [`TolMode::Noisy`], a patch with fewer points than this is judged on the points of
+    /// its 3 × 3 patch neighbourhood (a 95 % share or a standard deviation of a handful of
+    /// points says nothing about noise) [16].
+    pub min_sample: usize,
+    /// How the initial parameters are found.
+    pub param: ParamOptions,
+}
+
+impl SurfaceGrid {
+    /// The defaults, as each field documents them.
+    pub const DEFAULT: SurfaceGrid = SurfaceGrid {
+        degree: 3,
+        control: (8, 8),
+        fixed_knots: false,
+        tol_pct: 0.1,
+        tol_mode: TolMode::Noisy,
+        max_control_points: 40_000,
+        min_sample: 16,
+        param: ParamOptions::DEFAULT,
+    };
+
+    /// Range checks of degree, control counts and tolerance.
+    pub fn validate(&self) -> Result<(), FitError> {
+        let bad = |name, reason| Err(FitError::InvalidOption { name, reason });
+        let degree = self.degree;
+        if degree == 0 || degree > MAX_DEGREE {
+            return bad("degree", format!("{degree} is outside 1..={MAX_DEGREE}"));
+        }
+        let (nu, nv) = self.control;
+        if nu <= degree || nv <= degree {
+            return bad(
+                "grid",
+                format!("{nu} × {nv} control points cannot carry degree {degree}"),
+            );
+        }
+        if !(self.tol_pct.is_finite() && self.tol_pct > 0.0) {
+            return bad(
+                "tolMax",
+                format!("{} must be a positive percentage", self.tol_pct),
+            );
+        }
+        Ok(())
+    }
+
+    /// How patches are judged on data whose bounding-box diagonal is `diagonal`.
+    pub(crate) fn criterion(&self, diagonal: f64) -> Criterion {
+        Criterion {
+            tol: self.tol_pct / 100.0 * diagonal,
+            mode: self.tol_mode,
+            min_sample: self.min_sample,
+        }
+    }
+}
+
+impl Default for SurfaceGrid {
+    fn default() -> Self {
+        SurfaceGrid::DEFAULT
+    }
+}
+
+setters!([SurfaceGrid, GeometricSurfaceOptions, LsqSurfaceOptions] {
+    /// Sets the degree.
+    with_degree(degree: usize) => |s| s.grid_mut().degree;
+    /// Keeps the knots fixed.
+    with_fixed_knots(fixed_knots: bool) => |s| s.grid_mut().fixed_knots;
+    /// Sets the cap on control points.
+    with_max_control_points(max_control_points: usize) => |s| s.grid_mut().max_control_points;
+    /// Sets the smallest sample (in points) of the noisy patch test.
+    with_min_sample(min_sample: usize) => |s| s.grid_mut().min_sample;
+    /// Sets the parameterisation options.
+    with_param(param: ParamOptions) => |s| s.grid_mut().param;
+});
+
+/// The setters that take two values, for every options type holding a [`SurfaceGrid`].
+macro_rules! grid_pair_setters {
+    ($($ty:ty),+) => {$(
+        impl $ty {
+            /// Sets the initial control-point counts.
+            pub fn with_control(mut self, nu: usize, nv: usize) -> Self {
+                self.grid_mut().control = (nu, nv);
+                self
+            }
+            /// Sets the tolerance (%) and its mode.
+            pub fn with_tolerance(mut self, tol_pct: f64, mode: TolMode) -> Self {
+                let grid = self.grid_mut();
+                grid.tol_pct = tol_pct;
+                grid.tol_mode = mode;
+                self
+            }
+        }
+    )+};
+}
+grid_pair_setters!(SurfaceGrid, GeometricSurfaceOptions, LsqSurfaceOptions);
+
+impl SurfaceGrid {
+    /// Itself: lets one set of setters serve every options type that holds a grid.
+    pub(crate) fn grid_mut(&mut self) -> &mut SurfaceGrid {
+        self
+    }
+}
+
+/// The failing-patch share of both surface fitters' early split, a fraction in 0..=1.
+pub(crate) fn check_early_split_share(share: f64) -> Result<(), FitError> {
+    if (0.0..=1.0).contains(&share) {
+        return Ok(());
+    }
+    Err(FitError::InvalidOption {
+        name: "earlySplitShare",
+        reason: format!("{share} is outside 0..=1"),
+    })
+}
+
+/// The initial clamped uniform surface over the projection plane, control points at the
+/// Greville abscissae.
+pub(crate) fn plane_surface(
+    param: &Parameterization,
+    degree: usize,
+    (nu, nv): (usize, usize),
+) -> Result<BSplineSurface, FitError> {
+    let spline = |e: SplineError| FitError::InvalidOption {
+        name: "grid",
+        reason: e.to_string(),
+    };
+    let ku = KnotVector::clamped_uniform(degree, nu).map_err(spline)?;
+    let kv = KnotVector::clamped_uniform(degree, nv).map_err(spline)?;
+    let greville = |kv: &KnotVector, i: usize| {
+        let k = kv.knots();
+        k[i + 1..=i + degree].iter().sum::<f64>() / degree as f64
+    };
+    let control = (0..nu * nv)
+        .map(|idx| {
+            let (u, v) = (greville(&ku, idx / nv), greville(&kv, idx % nv));
+            param.frame.map_or(Point3::new(u, v, 0.0), |f| f.at(u, v))
+        })
+        .collect();
+    BSplineSurface::try_new(ku, kv, control).map_err(spline)
+}
+
+/// The foot points S(u, v) of parameters `uv`.
+pub(crate) fn surface_feet(s: &BSplineSurface, uv: &[[f64; 2]]) -> Vec<Point3> {
+    uv.iter().map(|t| s.eval(t[0], t[1])).collect()
+}
+
+/// The control grid as a quad mesh.
+pub(crate) fn control_grid(s: &BSplineSurface) -> Shape {
+    let (nu, nv) = s.num_control();
+    Shape::Mesh(grid_mesh(s.control_points().to_vec(), nu, nv))
+}
+
+/// The surface sampled `resolution` times per knot span in each direction, as a quad mesh.
+pub(crate) fn surface_mesh(s: &BSplineSurface, resolution: usize) -> Shape {
+    let r = resolution.clamp(1, 64);
+    let (us, vs) = (span_samples(s.knots_u(), r), span_samples(s.knots_v(), r));
+    let points = us
+        .iter()
+        .flat_map(|&u| vs.iter().map(move |&v| s.eval(u, v)))
+        .collect();
+    Shape::Mesh(grid_mesh(points, us.len(), vs.len()))
+}
+
+/// Iso-parameter lines at the knots, as segment end points (`resolution` segments per span).
+pub(crate) fn iso_lines(s: &BSplineSurface, resolution: usize) -> Vec<Point3> {
+    let r = resolution.clamp(1, 64);
+    let (us, vs) = (span_samples(s.knots_u(), r), span_samples(s.knots_v(), r));
+    let (ku, kv) = (span_samples(s.knots_u(), 1), span_samples(s.knots_v(), 1));
+    let mut out = Vec::new();
+    for &u in &ku {
+        out.extend(segments(vs.iter().map(|&v| s.eval(u, v))));
+    }
+    for &v in &kv {
+        out.extend(segments(us.iter().map(|&u| s.eval(u, v))));
+    }
+    out
+}
+
+/// What both surface fitters report besides the common figures.
+pub(crate) fn details(
+    s: &BSplineSurface,
+    folded: usize,
+) -> serde_json::Map<String, serde_json::Value> {
+    let (nu, nv) = s.num_control();
+    let mut m = serde_json::Map::new();
+    m.insert("control_points_u".into(), nu.into());
+    m.insert("control_points_v".into(), nv.into());
+    m.insert("folded_points".into(), folded.into());
+    m
+}
+
+/// The distinct knots inside the domain, with `per_span - 1` parameters between neighbours.
+fn span_samples(knots: &KnotVector, per_span: usize) -> Vec<f64> {
+    let (a, b) = knots.domain();
+    let mut distinct: Vec<f64> = knots
+        .knots()
+        .iter()
+        .copied()
+        .filter(|&k| k >= a && k <= b)
+        .collect();
+    distinct.dedup();
+    let mut out = Vec::with_capacity(distinct.len() * per_span);
+    for w in distinct.windows(2) {
+        for k in 0..per_span {
+            out.push(w[0] + (w[1] - w[0]) * k as f64 / per_span as f64);
+        }
+    }
+    out.extend(distinct.last());
+    out
+}
+
+/// Consecutive points as segment end points: a, b, b, c, ...
+fn segments(points: impl Iterator<Item = Point3>) -> Vec<Point3> {
+    let pts: Vec<Point3> = points.collect();
+    pts.windows(2).flat_map(|w| [w[0], w[1]]).collect()
+}
+
+/// A mesh over `points` laid out as an `nu × nv` grid (vertex `(i, j)` at `i * nv + j`); empty
+/// when a point is not finite (the fitters keep control points and surface points finite).
+fn grid_mesh(points: Vec<Point3>, nu: usize, nv: usize) -> PolyMesh {
+    let at = |i: usize, j: usize| (i * nv + j) as u32;
+    let mut quads = Vec::with_capacity(nu.saturating_sub(1) * nv.saturating_sub(1));
+    for i in 1..nu {
+        for j in 1..nv {
+            quads.push([at(i - 1, j - 1), at(i, j - 1), at(i, j), at(i - 1, j)]);
+        }
+    }
+    PolyMesh::try_new(points, quads).unwrap_or_default()
+}
