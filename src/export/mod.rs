@@ -7,8 +7,11 @@
 //! equivalent with the closed flag set, which every CAD reader accepts. Coordinates are written
 //! in millimetres, unscaled, with round-trip precision.
 
+mod fitted;
 pub mod iges;
 pub mod step;
+
+pub use fitted::{cad_model, cage_obj, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION};
 
 use crate::geom::Point3;
 use crate::spline::{BSplineCurve, KnotVector, SplineError};
@@ -39,6 +42,12 @@ pub enum ExportError {
     /// The curve could not be converted (closed curve clamping).
     #[error(transparent)]
     Spline(#[from] SplineError),
+    /// The fit has nothing of this kind to export (the message says what to export instead).
+    #[error("{what}")]
+    Unsupported {
+        /// What was asked for and why it cannot be given.
+        what: String,
+    },
 }
 
 /// A clamped B-spline or NURBS curve as the writers need it.

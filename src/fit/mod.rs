@@ -74,13 +74,24 @@ pub enum Shape {
     },
 }
 
-/// The fitted spline of a fit that has one, for CAD export.
+/// The fitted spline of a fit that has one (for CAD export), with the data points' foot-point
+/// parameters on it, in data order.
 #[derive(Clone, Copy, Debug)]
 pub enum Spline<'a> {
     /// A tensor-product B-spline / NURBS surface.
-    Surface(&'a BSplineSurface),
+    Surface {
+        /// The surface.
+        surface: &'a BSplineSurface,
+        /// (u, v) of every data point's foot point.
+        params: &'a [[f64; 2]],
+    },
     /// A B-spline / NURBS curve.
-    Curve(&'a BSplineCurve),
+    Curve {
+        /// The curve.
+        curve: &'a BSplineCurve,
+        /// u of every data point's foot point.
+        params: &'a [f64],
+    },
 }
 
 /// The interface every fitting engine offers: iterate, and read where the fit stands.

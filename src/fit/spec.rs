@@ -33,7 +33,7 @@ use super::surface::{
 use super::{Acceleration, FitError, Fitter, Tolerances};
 use crate::cloud::{ReconstructOptions, SurfaceKind};
 use crate::geom::{Point3, Vec3};
-use crate::io::RangeGrid;
+use crate::io::{LoadedFile, RangeGrid};
 use crate::mesh::PolyMesh;
 use crate::subdiv;
 use serde::{Deserialize, Serialize};
@@ -153,6 +153,18 @@ pub struct FitData<'a> {
     pub polylines: &'a [Vec<u32>],
     /// A control mesh to start a subdivision fit from, instead of simplifying the data.
     pub control: Option<&'a PolyMesh>,
+}
+
+/// What a fit of a file runs on: its points and faces, range grid and polylines.
+impl<'a> From<&'a LoadedFile> for FitData<'a> {
+    fn from(file: &'a LoadedFile) -> FitData<'a> {
+        FitData {
+            mesh: &file.mesh,
+            grid: file.range_grid.as_ref(),
+            polylines: &file.polylines,
+            control: None,
+        }
+    }
 }
 
 impl<'a> FitData<'a> {

@@ -35,7 +35,6 @@ pub use write::{
     to_obj_bytes, to_ply_bytes, to_stl_bytes, write_obj, write_ply, write_stl, WriteError,
 };
 
-use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use serde::Serialize;
 use std::fmt;
@@ -96,22 +95,6 @@ impl LoadedFile {
         }
     }
 
-    /// The points of a curve in order, and whether it is closed: the longest polyline of the
-    /// file (closed when it returns to its first vertex, which is then given once), or else all
-    /// points in file order, open.
-    pub fn curve_points(&self) -> (Vec<Point3>, bool) {
-        let pos = self.mesh.positions();
-        let Some(line) = self.polylines.iter().max_by_key(|l| l.len()) else {
-            return (pos.to_vec(), false);
-        };
-        let closed = line.len() > 2 && line.first() == line.last();
-        let take = if closed { line.len() - 1 } else { line.len() };
-        let points = line[..take]
-            .iter()
-            .filter_map(|&i| pos.get(i as usize).copied())
-            .collect();
-        (points, closed)
-    }
 }
 
 /// Reads a file from bytes. The format is taken from the content, with `name` (a file name

@@ -282,6 +282,21 @@ impl BSplineCurve {
         self.closest_point_from(p, best.0, &NewtonOptions::DEFAULT.with_max_iter(30))
     }
 
+    /// `count` (at least 2) parameters evenly spread over the domain, ends included, with the
+    /// curve's points there, as `[u, x, y, z]`: what reports and interoperability checks
+    /// compare.
+    pub fn samples(&self, count: usize) -> Vec<[f64; 4]> {
+        let (a, b) = self.domain();
+        let count = count.max(2);
+        (0..count)
+            .map(|i| {
+                let u = a + (b - a) * i as f64 / (count - 1) as f64;
+                let p = self.eval(u);
+                [u, p.x, p.y, p.z]
+            })
+            .collect()
+    }
+
     /// Parameters spread over every non-empty knot span (span starts and interior samples),
     /// plus the domain end of an open curve.
     pub fn sample_params(&self, per_span: usize) -> Vec<f64> {

@@ -860,7 +860,7 @@ impl Graph {
     /// The root of a Doo–Sabin patch: the fan of a control vertex, refined once; the patch is
     /// the new point of face 0's corner at the vertex, with the same parameters.
     fn build_doo_sabin_root(&mut self, topo: &Topo, patch: usize) -> Result<Node, SubdivError> {
-        let refined = super::doo_sabin::refine(&topo);
+        let refined = super::doo_sabin::refine(topo);
         // Face 0 starts at local vertex 0, so its corner point is new point 0, and the face
         // made from face 0 is new face 0.
         let nb = vertex_neighbourhood(&refined.topo, 0, 0, Kind::Vertex);
@@ -882,7 +882,7 @@ impl Graph {
                 gather: Sparse::from_dense(rows, k, &gather),
             });
         }
-        let refined = super::step::refine_step(&topo, self.scheme);
+        let refined = super::step::refine_step(topo, self.scheme);
         let maps = child_maps(self.scheme);
         let mut children = Vec::with_capacity(maps.len());
         for (ci, map) in maps.into_iter().enumerate() {

@@ -2,12 +2,11 @@
 //! Names are camelCase on the JavaScript side; bulk data crosses as typed arrays; every error
 //! reaches JavaScript as a thrown `Error` carrying the Rust error's message.
 
-mod engine;
 mod fitter;
 mod scan;
 mod viewer;
 
-pub use fitter::{Fitter, MeshArrays};
+pub use fitter::{default_spec, methods_for, options_for, Fitter, MeshArrays};
 pub use scan::{load_file, LoadedScan};
 pub use viewer::Viewer;
 

@@ -1,6 +1,5 @@
 //! `loadFile` and the `LoadedScan` handle: a parsed point or mesh file, ready to draw.
 
-use crate::geom::Point3;
 use crate::io::{self, LoadedFile};
 use crate::render::buffers;
 use wasm_bindgen::prelude::*;
@@ -20,19 +19,9 @@ pub fn load_file(bytes: &[u8], name: &str) -> Result<LoadedScan, JsError> {
 }
 
 impl LoadedScan {
-    /// The parsed points and faces.
-    pub(crate) fn mesh(&self) -> &crate::mesh::PolyMesh {
-        &self.file.mesh
-    }
-
-    /// Ordered points for curve fitting and whether the file closes them into a loop.
-    pub(crate) fn curve_points(&self) -> (Vec<Point3>, bool) {
-        self.file.curve_points()
-    }
-
-    /// The scanner grid of a raw range scan, if the file has one.
-    pub(crate) fn range_grid(&self) -> Option<&io::RangeGrid> {
-        self.file.range_grid.as_ref()
+    /// What a fit of this file runs on.
+    pub(crate) fn fit_data(&self) -> crate::fit::FitData<'_> {
+        crate::fit::FitData::from(&self.file)
     }
 }
 

@@ -3,7 +3,7 @@
 //! points geofit evaluates there, so a CAD kernel can be checked against them
 //! (tests/interop/test_export_occ.py does this with Open CASCADE).
 
-use crate::fit_curve::{curve_samples, write_exports};
+use crate::output::write_exports;
 use geofit::export::{CurveDesc, ExportModel, SurfaceDesc};
 use geofit::geom::Point3;
 use geofit::spline::BSplineCurve;
@@ -125,7 +125,7 @@ pub fn run(args: Args) -> Result<(), String> {
             "name": name, "iges": iges, "step": step, "closed": curve.is_closed(),
             "rational": curve.weights().is_some(),
             "domain": [curve.domain().0, curve.domain().1],
-            "samples": curve_samples(&curve, 41),
+            "samples": curve.samples(41),
         }));
     }
     let mut surface_json = Vec::new();

@@ -1,97 +1,39 @@
-//! `geofit fit FILE --scheme loop|catmull-clark|doo-sabin ...`: fit a subdivision surface to a
-//! scan by geometric iteration, print one line per iteration, optionally write a JSON report,
-//! the control mesh and the limit surface.
+//! `geofit fit FILE [--scheme S] [options]`: fit any scheme — a Loop, Catmull–Clark or Doo–Sabin
+//! subdivision surface, one B-spline surface, or a B-spline / Chaikin curve — to a scan. The
+//! flags fill a [`FitSpec`] (every default and range check is the core's); one line per
+//! iteration, a summary, and the files asked for.
 
-use clap::ValueEnum;
-use geofit::cloud::{ReconstructOptions, SurfaceKind};
+use crate::output::read_input;
+use geofit::export::{self, EXPORT_RESOLUTION};
 use geofit::fit::{
-    build_subdiv_fitter, Acceleration, FitReport, FitStatus, Fitter, SubdivFitOptions, SubdivSetup,
-    Tolerances, Weighting,
+    Cloud, FitData, FitError, FitReport, FitSpec, FitStatus, Fitter, Method, Scheme, Shape,
+    Spline, Weighting, OPTION_TABLE,
 };
-use geofit::mesh::PolyMesh;
-use geofit::subdiv::Scheme;
+use geofit::fit::{Acceleration, FoldPolicy, TolMode};
+use geofit::geom::Vec3;
+use geofit::spline::BSplineSurface;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Surface kinds `geofit fit` can produce.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SchemeArg {
-    /// Loop subdivision surface (triangle control mesh).
-    Loop,
-    /// Catmull–Clark subdivision surface (quad control mesh).
-    CatmullClark,
-    /// Doo–Sabin subdivision surface.
-    DooSabin,
-    /// One tensor-product B-spline surface (options under "B-spline surface"; --tol-max
-    /// defaults to 0.1 there, and the JSON report is printed).
-    Bspline,
-}
-
-/// Error-vector weighting.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum WeightsArg {
-    /// The patent's barycentric / bilinear weights over the 1-ring faces.
-    Patent,
-    /// Basis (limit-stencil) weights of every influencing control point (LSPIA).
-    Basis,
-}
-
-/// Acceleration of the iteration.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum AccelArg {
-    /// Plain iteration P ← P + d.
-    None,
-    /// Constant over-relaxation P ← P + 1.5 d.
-    Relax,
-    /// Anderson acceleration over the last 5 iterates.
-    Anderson,
-    /// 12 conjugate-gradient steps per iteration on the frozen foot parameters (basis weights).
-    Cg,
-}
-
-/// How a point file without faces is turned into a mesh to start from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum CloudArg {
-    /// Decide from the data (a range grid, or normals mostly facing one side, mean open).
-    Auto,
-    /// An open single-view scan: range grid or Delaunay on the best-fit plane.
-    Open,
-    /// A closed object: oriented normals and an implicit surface.
-    Closed,
-}
-
-/// Arguments of `geofit fit`.
+/// Arguments of `geofit fit`. Left out, an option takes the core's default for the scheme
+/// (listed after the options by `geofit fit --help`).
 #[derive(clap::Args)]
-#[command(after_help = "\
-Without --initial the initial control mesh has n/60 vertices for n data points (at least 50, at \
-most 20,000, and never more than the data mesh has), a density at which QEM keeps the shape of \
-scans like the Stanford bunny (35,947 points -> 599). Point files without faces are first reconstructed into a mesh (see --cloud, --outliers; as `geofit reconstruct`), which QEM then simplifies; the fit runs on the original points. Tolerances are % of the data's bounding-box \
-diagonal; a fit stops when every tolerance given is met (with none given: --tol-avg 0.01 \
---tol-max 0.05) or after --max-iter iterations.")]
+#[command(after_help = defaults_help())]
 pub struct Args {
-    /// Data file (PLY, OBJ, STL, XYZ/CSV/PTS). Every vertex is a data point, also those in no face.
+    /// Data file (PLY, OBJ, STL, XYZ/CSV/PTS). Every vertex is a data point, also those in no
+    /// face; curves take an OBJ polyline or the points in file order.
     file: PathBuf,
-    /// Surface scheme.
-    #[arg(long, value_enum, default_value = "loop")]
-    scheme: SchemeArg,
-    /// Vertex count of the initial control mesh made from the data by QEM simplification.
-    #[arg(long, conflicts_with = "control")]
-    initial: Option<usize>,
-    /// Start from this control mesh instead of simplifying the data.
-    #[arg(long)]
-    control: Option<PathBuf>,
-    /// Point files without faces: the kind of surface to reconstruct before simplifying.
-    #[arg(long, value_enum, default_value = "auto")]
-    cloud: CloudArg,
-    /// Point files without faces: statistical outlier removal, dropping points whose mean
-    /// neighbour distance is this many standard deviations above the mean (they are not
-    /// fitted either).
-    #[arg(long, alias = "remove-outliers")]
-    outliers: Option<f64>,
-    /// Point files without faces: ignore the file's range grid (triangulate by Delaunay).
-    #[arg(long)]
-    no_grid: bool,
-    /// Tolerance on E_avg, % of the bounding-box diagonal.
+    /// What is fitted: loop, catmull-clark, doo-sabin, bspline-surface (alias bspline),
+    /// bspline-curve, chaikin-curve.
+    #[arg(long, default_value = "loop", value_parser = parse::<Scheme>)]
+    scheme: Scheme,
+    /// How control points are found: geometric, least-squares (B-spline surface), knots
+    /// (curves).
+    #[arg(long, value_parser = parse::<Method>)]
+    method: Option<Method>,
+    /// Tolerance on E_avg, % of the bounding-box diagonal (giving any tolerance means only the
+    /// given ones count).
     #[arg(long)]
     tol_avg: Option<f64>,
     /// Tolerance on E_max, %.
@@ -100,163 +42,289 @@ pub struct Args {
     /// Tolerance on E_rms, %.
     #[arg(long)]
     tol_rms: Option<f64>,
-    /// Iteration cap.
-    #[arg(long, default_value_t = 200)]
-    max_iter: usize,
-    /// Control-point budget for refinement (default: half the number of data points).
+    /// Initial control points: vertices of the QEM-simplified control mesh (subdivision), or
+    /// about that many in a square grid (B-spline surface).
+    #[arg(long, conflicts_with = "control")]
+    initial: Option<usize>,
+    /// B-spline surface: exactly N control points in a √N × √N grid, knots kept fixed.
+    #[arg(long, conflicts_with_all = ["ctrl_u", "ctrl_v", "initial"])]
+    ctrl: Option<usize>,
+    /// B-spline surface: control points along u (with --ctrl-v), knots kept fixed.
+    #[arg(long, requires = "ctrl_v")]
+    ctrl_u: Option<usize>,
+    /// B-spline surface: control points along v (with --ctrl-u).
+    #[arg(long, requires = "ctrl_u")]
+    ctrl_v: Option<usize>,
+    /// Subdivision: start from this control mesh instead of simplifying the data.
+    #[arg(long)]
+    control: Option<PathBuf>,
+    /// Iteration cap (knot insertions for the knots method).
+    #[arg(long)]
+    max_iter: Option<usize>,
+    /// Control-point budget of refinement.
     #[arg(long)]
     max_control: Option<usize>,
-    /// Never split control faces.
+    /// Never split control faces / insert knots.
     #[arg(long)]
     no_refine: bool,
-    /// No edge flips after a refinement (Loop).
+    /// Subdivision (Loop): no edge flips after a refinement.
     #[arg(long)]
     no_remesh: bool,
-    /// Error-vector weighting.
-    #[arg(long, value_enum, default_value = "basis")]
-    weights: WeightsArg,
-    /// Acceleration [default: cg with basis weights, none with patent weights].
-    #[arg(long, value_enum)]
-    accel: Option<AccelArg>,
-    /// With --accel cg: weight of the tangential error relative to the normal one, in (0, 1]
-    /// [default: 0.1].
+    /// Subdivision: error-vector weighting, basis or patent.
+    #[arg(long, value_parser = parse::<Weighting>)]
+    weights: Option<Weighting>,
+    /// Acceleration of the geometric iteration: none, relax, anderson, cg.
+    #[arg(long, value_parser = parse::<Acceleration>)]
+    accel: Option<Acceleration>,
+    /// Subdivision with cg: weight of the tangential error relative to the normal one, (0, 1].
     #[arg(long)]
     tangent_weight: Option<f64>,
-    /// One refinement adds at most this fraction of the current control points [default: 3,
-    /// so the out-of-tolerance faces decide; the budget caps it].
+    /// Subdivision: one refinement adds at most this fraction of the control points.
     #[arg(long)]
     refine_growth: Option<f64>,
-    /// Write the report (setup, final errors, times, per-iteration history) as JSON.
+    /// Subdivision, files without faces: auto, open or closed surface to reconstruct.
+    #[arg(long, value_parser = parse::<Cloud>)]
+    cloud: Option<Cloud>,
+    /// Subdivision, files without faces: drop points whose mean neighbour distance is this
+    /// many standard deviations above the mean (they are not fitted either).
+    #[arg(long, alias = "remove-outliers")]
+    outliers: Option<f64>,
+    /// Subdivision, files without faces: ignore the file's range grid (triangulate by
+    /// Delaunay).
+    #[arg(long)]
+    no_grid: bool,
+    /// Curves: fit a closed (periodic) curve; implied by an OBJ polyline that ends where it
+    /// starts.
+    #[arg(long)]
+    closed: bool,
+    /// Degree (B-spline surface, B-spline curve).
+    #[arg(long)]
+    degree: Option<usize>,
+    /// B-spline surface: how patches are judged against --tol-max, exact or noisy.
+    #[arg(long, value_parser = parse::<TolMode>)]
+    tol_mode: Option<TolMode>,
+    /// B-spline surface, least squares: thin-plate weight β2.
+    #[arg(long)]
+    beta2: Option<f64>,
+    /// B-spline surface, least squares: curvature-variation weight β3.
+    #[arg(long)]
+    beta3: Option<f64>,
+    /// B-spline surface, least squares: solves (each with parameter correction) per knot
+    /// vector.
+    #[arg(long)]
+    solves: Option<usize>,
+    /// B-spline surface: view direction "x,y,z" of the projection.
+    #[arg(long, value_parser = parse_vec3)]
+    view: Option<Vec3>,
+    /// B-spline surface: points on a fold-over of the projection, fail, exclude or keep.
+    #[arg(long, value_parser = parse::<FoldPolicy>)]
+    folded: Option<FoldPolicy>,
+    /// Curves, knots method: angle that makes a corner, degrees.
+    #[arg(long)]
+    corner_angle: Option<f64>,
+    /// Curves, knots method: second-derivative jump that makes a double knot, 1 / diagonal.
+    #[arg(long)]
+    curvature_jump: Option<f64>,
+    /// Write the report (set-up, final errors, times, per-iteration history) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Write the final control mesh as OBJ.
+    /// Write the final control net as OBJ (a curve's polygon as a polyline).
     #[arg(long)]
     cage: Option<PathBuf>,
-    /// Write the limit surface, tessellated, as OBJ.
+    /// Write the fitted surface, tessellated, as OBJ.
     #[arg(long)]
     limit: Option<PathBuf>,
     /// Segments per patch edge of the --limit tessellation.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = EXPORT_RESOLUTION)]
     limit_segments: usize,
+    /// B-spline surface: write the fitted surface (degree, knots, control grid, parameters) as
+    /// JSON.
+    #[arg(long)]
+    surface_json: Option<PathBuf>,
+    /// B-spline surface or curve: export as IGES 5.3.
+    #[arg(long)]
+    iges: Option<PathBuf>,
+    /// B-spline surface or curve: export as STEP AP214.
+    #[arg(long)]
+    step: Option<PathBuf>,
     /// Print only the summary, not one line per iteration.
     #[arg(long, short)]
     quiet: bool,
-    #[command(flatten)]
-    bspline: crate::fit_bspline::BsplineArgs,
+}
+
+/// A clap value parser for the core's named enums (one table of names).
+fn parse<T: std::str::FromStr<Err = String>>(s: &str) -> Result<T, String> {
+    s.parse()
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(format!("expected x,y,z, got {s:?}")),
+    }
+}
+
+/// The defaults of every scheme, from the core, for `--help`.
+fn defaults_help() -> String {
+    let mut out = String::from(
+        "Defaults by scheme (the core's FitSpec::defaults; `--no-X` turns off a default-on X; \
+         subdivision's initial count and budget come from the data: n/60 initial vertices, \
+         half the points as budget; a curve is closed when its polyline is):\n",
+    );
+    for &scheme in Scheme::ALL {
+        let d = FitSpec::defaults(scheme);
+        let value = serde_json::to_value(&d).unwrap_or_default();
+        let fields: Vec<String> = FitSpec::options_for(scheme, d.method())
+            .into_iter()
+            .filter(|name| *name != "scheme")
+            .filter_map(|name| {
+                let v = value.get(name)?;
+                let v = v.to_string();
+                (v != "null").then(|| format!("{}={}", kebab(name), v.trim_matches('"')))
+            })
+            .collect();
+        out.push_str(&format!("  {scheme}: {}\n", fields.join(" ")));
+    }
+    out
+}
+
+/// `tolAvg` as `tol-avg`.
+fn kebab(name: &str) -> String {
+    let mut out = String::new();
+    for c in name.chars() {
+        if c.is_ascii_uppercase() {
+            out.push('-');
+        }
+        out.push(c.to_ascii_lowercase());
+    }
+    out
+}
+
+/// The command-line flag of a spec field.
+fn flag_of(name: &str) -> &'static str {
+    OPTION_TABLE
+        .iter()
+        .find(|o| o.name == name)
+        .map_or("?", |o| o.flag)
 }
 
 impl Args {
-    fn options(&self) -> SubdivFitOptions {
-        let tolerances = Tolerances::given_or_default(self.tol_avg, self.tol_max, self.tol_rms);
-        let mut options = SubdivFitOptions::default()
-            .with_tolerances(tolerances)
-            .with_max_iter(self.max_iter)
-            .with_max_control(self.max_control)
-            .with_refine(!self.no_refine)
-            .with_remesh(!self.no_remesh)
-            .with_weighting(match self.weights {
-                WeightsArg::Patent => Weighting::Patent,
-                WeightsArg::Basis => Weighting::Basis,
-            })
-            .with_acceleration(
-                match self.accel.unwrap_or(match self.weights {
-                    WeightsArg::Basis => AccelArg::Cg,
-                    WeightsArg::Patent => AccelArg::None,
-                }) {
-                    AccelArg::None => Acceleration::None,
-                    AccelArg::Relax => Acceleration::Relax { omega: 1.5 },
-                    AccelArg::Anderson => Acceleration::Anderson { depth: 5 },
-                    AccelArg::Cg => Acceleration::cg(),
-                },
-            );
-        if let Some(w) = self.tangent_weight {
-            options = options.with_tangent_weight(w);
+    /// The spec the flags describe.
+    fn spec(&self) -> Result<FitSpec, String> {
+        let mut spec = FitSpec::new(self.scheme);
+        spec.method = self.method;
+        (spec.tol_avg, spec.tol_max, spec.tol_rms) = (self.tol_avg, self.tol_max, self.tol_rms);
+        spec.initial = self.initial;
+        spec.grid = self.ctrl_u.zip(self.ctrl_v).map(|(u, v)| [u, v]);
+        if let Some(n) = self.ctrl {
+            let side = (n as f64).sqrt().round() as usize;
+            if side * side != n {
+                return Err(format!(
+                    "--ctrl {n} is not a square; use --ctrl-u and --ctrl-v"
+                ));
+            }
+            spec.grid = Some([side, side]);
         }
-        if let Some(g) = self.refine_growth {
-            options.refine_growth = g;
-        }
-        options
+        spec.refine = !self.no_refine && spec.grid.is_none();
+        spec.max_iter = self.max_iter;
+        spec.max_control = self.max_control;
+        spec.remesh = !self.no_remesh;
+        spec.weights = self.weights.unwrap_or(spec.weights);
+        spec.acceleration = self.accel;
+        spec.tangent_weight = self.tangent_weight;
+        spec.refine_growth = self.refine_growth;
+        spec.cloud = self.cloud.unwrap_or(spec.cloud);
+        spec.outliers = self.outliers;
+        spec.use_grid = !self.no_grid;
+        spec.closed = self.closed.then_some(true);
+        spec.degree = self.degree;
+        spec.tol_mode = self.tol_mode.unwrap_or(spec.tol_mode);
+        (spec.beta2, spec.beta3, spec.solves) = (self.beta2, self.beta3, self.solves);
+        spec.view = self.view.map(|v| v.to_array());
+        spec.folded = self.folded.unwrap_or(spec.folded);
+        (spec.corner_angle, spec.curvature_jump) = (self.corner_angle, self.curvature_jump);
+        self.check_outputs()?;
+        Ok(spec)
     }
 
-    fn cloud(&self) -> ReconstructOptions {
-        ReconstructOptions::default()
-            .with_kind(match self.cloud {
-                CloudArg::Auto => None,
-                CloudArg::Open => Some(SurfaceKind::Open),
-                CloudArg::Closed => Some(SurfaceKind::Closed),
-            })
-            .with_outlier_std_ratio(self.outliers)
+    /// The output files the scheme cannot write are errors, not silently skipped.
+    fn check_outputs(&self) -> Result<(), String> {
+        let s = self.scheme;
+        let spline = s == Scheme::BsplineSurface || s.is_curve();
+        for (flag, given, ok) in [
+            ("--iges", self.iges.is_some(), spline),
+            ("--step", self.step.is_some(), spline),
+            ("--limit", self.limit.is_some(), !s.is_curve()),
+            (
+                "--surface-json",
+                self.surface_json.is_some(),
+                s == Scheme::BsplineSurface,
+            ),
+            ("--control", self.control.is_some(), s.subdivision().is_some()),
+            (
+                "--ctrl",
+                self.ctrl.is_some() || self.ctrl_u.is_some(),
+                s == Scheme::BsplineSurface,
+            ),
+        ] {
+            if given && !ok {
+                return Err(format!("{flag} does not apply to --scheme {s}"));
+            }
+        }
+        Ok(())
     }
 }
 
-fn read(path: &Path) -> Result<PolyMesh, String> {
-    geofit::io::read_path(path)
-        .map(|loaded| loaded.mesh)
-        .map_err(|e| format!("{}: {e}", path.display()))
+/// A spec error in the command line's words: flags, not field names.
+fn cli_error(e: FitError) -> String {
+    match e {
+        FitError::NotApplicable { name, scheme, .. } => {
+            let info = OPTION_TABLE.iter().find(|o| o.name == name);
+            let schemes: Vec<&str> = Scheme::ALL
+                .iter()
+                .filter(|s| info.is_some_and(|o| o.applies(**s, s.default_method())))
+                .map(|s| s.name())
+                .collect();
+            format!(
+                "--{} does not apply to --scheme {scheme} (it applies to {})",
+                flag_of(name),
+                schemes.join(", ")
+            )
+        }
+        FitError::InvalidOption { name, reason } => format!("--{}: {reason}", flag_of(name)),
+        other => other.to_string(),
+    }
 }
 
 pub fn run(args: Args) -> Result<(), String> {
-    let scheme = match args.scheme {
-        SchemeArg::Loop => Scheme::Loop,
-        SchemeArg::CatmullClark => Scheme::CatmullClark,
-        SchemeArg::DooSabin => Scheme::DooSabin,
-        SchemeArg::Bspline => return run_bspline(&args),
-    };
-    if let Some(flag) = args.bspline.first_given() {
-        return Err(format!("{flag} applies to --scheme bspline only"));
-    }
     let start = Instant::now();
-    let file =
-        geofit::io::read_path(&args.file).map_err(|e| format!("{}: {e}", args.file.display()))?;
-    let control = args.control.as_deref().map(read).transpose()?;
-    let grid = file.range_grid.as_ref().filter(|_| !args.no_grid);
-    let setup = build_subdiv_fitter(
-        &file.mesh,
-        grid,
-        &args.cloud(),
-        scheme,
-        control,
-        args.initial,
-        args.options(),
-    )
-    .map_err(|e| format!("{}: {e}", args.file.display()))?;
-    // Reading, reconstruction and QEM count as precompute; the report adds the fitter's own
-    // set-up time.
-    let before_fitter =
-        (start.elapsed().as_secs_f64() - setup.fitter.precompute_seconds()).max(0.0);
-    drive(setup, before_fitter, &args)
-}
-
-/// The `--scheme bspline` branch: the shared options that apply, then the B-spline fit.
-fn run_bspline(args: &Args) -> Result<(), String> {
-    let unsupported = [
-        ("--tol-avg", args.tol_avg.is_some()),
-        ("--tol-rms", args.tol_rms.is_some()),
-        ("--initial", args.initial.is_some()),
-        ("--control", args.control.is_some()),
-        ("--cage", args.cage.is_some()),
-        ("--limit", args.limit.is_some()),
-    ];
-    if let Some((flag, _)) = unsupported.iter().find(|f| f.1) {
-        return Err(format!("{flag} does not apply to --scheme bspline"));
-    }
-    let common = crate::fit_bspline::Common {
-        file: &args.file,
-        tol_max: args.tol_max,
-        max_iter: args.max_iter,
-        max_control: args.max_control,
-        json: args.json.as_deref(),
+    let spec = args.spec()?;
+    spec.validate().map_err(cli_error)?;
+    let file = read_input(&args.file)?;
+    let control = match &args.control {
+        Some(path) => Some(read_input(path)?.mesh),
+        None => None,
     };
-    crate::fit_bspline::run(common, &args.bspline)
+    let data = FitData {
+        control: control.as_ref(),
+        ..FitData::from(&file)
+    };
+    let read_s = start.elapsed().as_secs_f64();
+    let mut fitter = spec
+        .build(&data)
+        .map_err(|e| format!("{}: {}", args.file.display(), cli_error(e)))?;
+    fitter.log_mut().add_precompute(read_s);
+    drive(fitter.as_mut(), &args)?;
+    write_outputs(fitter.as_ref(), &args)
 }
 
-/// Iterates to the end, printing progress, then writes the outputs.
-fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), String> {
-    let SubdivSetup {
-        mut fitter,
-        reconstruction,
-    } = setup;
-    if let (false, Some(r)) = (args.quiet, &reconstruction) {
+/// Iterates to the end, printing one line per iteration unless quiet, then the summary.
+fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
+    if let (false, Some(r)) = (args.quiet, fitter.log().reconstruction()) {
         outln!(
             "reconstructed {} surface ({}): {} triangles, {} outliers removed, {:.3} s",
             r.kind,
@@ -275,14 +343,14 @@ fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), Stri
             s.e_max_pct,
             s.e_rms_pct,
             fitter.data().len(),
-            before_fitter + fitter.precompute_seconds()
+            fitter.log().precompute_seconds()
         );
     }
-    let fit_start = Instant::now();
     loop {
+        let before = fitter.history().len();
         let status = fitter.step().map_err(|e| e.to_string())?;
-        if let (false, Some(r)) = (args.quiet, fitter.history().last()) {
-            outln!(
+        match fitter.history().last() {
+            Some(r) if !args.quiet && fitter.history().len() > before => outln!(
                 "iter {:>3}  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%  {:7.1} ms{}",
                 r.iter,
                 r.control_points,
@@ -291,14 +359,14 @@ fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), Stri
                 r.e_rms_pct,
                 r.ms,
                 if r.refined { "  refined" } else { "" }
-            );
+            ),
+            _ => {}
         }
         if status != FitStatus::Running {
             break;
         }
     }
-    let mut report = FitReport::of(&fitter, before_fitter, fit_start.elapsed().as_secs_f64());
-    report.reconstruction = reconstruction;
+    let report = FitReport::of(fitter);
     let within = report.within_tolerance_pct.map_or(String::new(), |w| {
         format!(" ({w:.2}% of points within E_max tolerance)")
     });
@@ -317,21 +385,70 @@ fn drive(setup: SubdivSetup, before_fitter: f64, args: &Args) -> Result<(), Stri
         report.fit_s,
         report.total_s
     );
+    Ok(())
+}
+
+/// Writes the files asked for.
+fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
+    let write = |path: &Path, bytes: &[u8]| {
+        std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    let name = args
+        .file
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or("geofit");
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
-        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = serde_json::to_string_pretty(&FitReport::of(fitter)).map_err(|e| e.to_string())?;
+        write(path, text.as_bytes())?;
     }
     if let Some(path) = &args.cage {
-        write_obj(path, &fitter.control_mesh())?;
+        write(path, &export::cage_obj(fitter).map_err(|e| e.to_string())?)?;
     }
-    if let Some(path) = &args.limit {
-        write_obj(path, &fitter.limit_mesh(args.limit_segments))?;
+    if let (Some(path), Shape::Mesh(mesh)) = (&args.limit, fitter.limit_shape(args.limit_segments))
+    {
+        write(path, &geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string())?)?;
+    }
+    if let Some(path) = &args.iges {
+        write(path, export::iges_of(fitter, name).map_err(|e| e.to_string())?.as_bytes())?;
+    }
+    if let Some(path) = &args.step {
+        write(path, export::step_of(fitter, name).map_err(|e| e.to_string())?.as_bytes())?;
+    }
+    if let (Some(path), Some(Spline::Surface { surface, params })) =
+        (&args.surface_json, fitter.spline())
+    {
+        let json = serde_json::to_string(&surface_json(surface, params)).map_err(|e| e.to_string())?;
+        write(path, json.as_bytes())?;
     }
     Ok(())
 }
 
-fn write_obj(path: &Path, mesh: &PolyMesh) -> Result<(), String> {
-    let file = std::fs::File::create(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut out = std::io::BufWriter::new(file);
-    geofit::io::write_obj(mesh, &mut out).map_err(|e| format!("{}: {e}", path.display()))
+/// The fitted surface as plain data.
+#[derive(Serialize)]
+struct SurfaceJson<'a> {
+    degree_u: usize,
+    degree_v: usize,
+    knots_u: &'a [f64],
+    knots_v: &'a [f64],
+    control_points_u: usize,
+    control_points_v: usize,
+    /// Row-major in u: index i · control_points_v + j.
+    control_points: Vec<[f64; 3]>,
+    /// Foot-point parameters (u, v) of every data point, in data order.
+    parameters: &'a [[f64; 2]],
+}
+
+fn surface_json<'a>(s: &'a BSplineSurface, parameters: &'a [[f64; 2]]) -> SurfaceJson<'a> {
+    let (nu, nv) = s.num_control();
+    SurfaceJson {
+        degree_u: s.knots_u().degree(),
+        degree_v: s.knots_v().degree(),
+        knots_u: s.knots_u().knots(),
+        knots_v: s.knots_v().knots(),
+        control_points_u: nu,
+        control_points_v: nv,
+        control_points: s.control_points().iter().map(|p| p.to_array()).collect(),
+        parameters,
+    }
 }

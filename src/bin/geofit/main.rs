@@ -12,8 +12,6 @@ macro_rules! outln {
 
 mod export_samples;
 mod fit;
-mod fit_bspline;
-mod fit_curve;
 mod info;
 mod output;
 mod reconstruct;
@@ -38,9 +36,6 @@ struct Cli {
 enum Command {
     /// Describe a point or mesh file.
     Info(info::Args),
-    /// Fit a B-spline curve to ordered points (geometric iteration or knot placement) and
-    /// export it as IGES/STEP.
-    FitCurve(fit_curve::Args),
     /// Write reference curves and surfaces as IGES and STEP with sampled points (for
     /// interoperability tests).
     ExportSamples(export_samples::Args),
@@ -52,7 +47,8 @@ enum Command {
     Reconstruct(reconstruct::Args),
     /// Refine a control mesh with a subdivision scheme (optionally to limit positions).
     Subdiv(subdiv::Args),
-    /// Fit a subdivision surface (geometric iteration) or a B-spline surface to a scan.
+    /// Fit a subdivision surface, a B-spline surface or a B-spline / Chaikin curve to a scan
+    /// (geometric iteration, least squares or knot placement), and export it.
     Fit(fit::Args),
 }
 
@@ -60,7 +56,6 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => info::run(args),
-        Command::FitCurve(args) => fit_curve::run(args),
         Command::ExportSamples(args) => export_samples::run(args),
         Command::Simplify(args) => simplify::run(args),
         Command::Reconstruct(args) => reconstruct::run(args),

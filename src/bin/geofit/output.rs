@@ -1,6 +1,7 @@
 //! What every subcommand does at its edges: read the input file with errors naming it, and print
 //! the JSON report (indented, or on one line with `--json`).
 
+use geofit::export::{iges::write_iges, step::write_step, ExportModel};
 use geofit::io::LoadedFile;
 use serde::Serialize;
 use std::path::Path;
@@ -33,4 +34,27 @@ pub fn write_line(line: std::fmt::Arguments) {
             eprintln!("geofit: standard output: {e}");
         }
     }
+}
+
+/// Writes `model` as IGES and STEP where paths are given, each named after its file.
+pub fn write_exports(
+    model: &ExportModel,
+    iges: Option<&Path>,
+    step: Option<&Path>,
+) -> Result<(), String> {
+    let name = |p: &Path| {
+        p.file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("geofit")
+            .to_string()
+    };
+    if let Some(path) = iges {
+        let text = write_iges(model, &name(path)).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if let Some(path) = step {
+        let text = write_step(model, &name(path)).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(())
 }

@@ -457,7 +457,10 @@ impl Fitter for CurveFitter {
     }
 
     fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Curve(&self.curve))
+        Some(Spline::Curve {
+            curve: &self.curve,
+            params: &self.params,
+        })
     }
 
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {

@@ -539,7 +539,10 @@ impl Fitter for KnotPlacementFitter {
     }
 
     fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Curve(&self.curve))
+        Some(Spline::Curve {
+            curve: &self.curve,
+            params: &self.feet,
+        })
     }
 
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {

@@ -67,20 +67,6 @@ fn curve_shape(c: &BSplineCurve, resolution: usize) -> Shape {
     }
 }
 
-/// Sample parameters and points of a curve (`[u, x, y, z]`), for the report and for
-/// interoperability checks.
-pub fn curve_samples(curve: &BSplineCurve, count: usize) -> Vec<[f64; 4]> {
-    let (a, b) = curve.domain();
-    let count = count.max(2);
-    (0..count)
-        .map(|i| {
-            let u = a + (b - a) * i as f64 / (count - 1) as f64;
-            let p = curve.eval(u);
-            [u, p.x, p.y, p.z]
-        })
-        .collect()
-}
-
 /// What both curve fitters report besides the common figures: degree, closedness, domain,
 /// 101 samples of the curve and its clamped (open-knot) form for CAD readers.
 fn details(curve: &BSplineCurve) -> serde_json::Map<String, serde_json::Value> {
@@ -91,15 +77,16 @@ fn details(curve: &BSplineCurve) -> serde_json::Map<String, serde_json::Value> {
     m.insert("domain".into(), serde_json::json!([a, b]));
     m.insert(
         "samples".into(),
-        serde_json::json!(curve_samples(curve, 101)),
+        serde_json::json!(curve.samples(101)),
     );
-    if let Ok(desc) = crate::export::CurveDesc::from_curve(curve) {
+    if let Ok(clamped) = curve.to_clamped() {
+        let points: Vec<[f64; 3]> = clamped.control_points().iter().map(|p| p.to_array()).collect();
         m.insert(
             "clamped".into(),
             serde_json::json!({
-                "degree": desc.degree,
-                "knots": desc.knots,
-                "control_points": desc.control_points.iter().map(|p| p.to_array()).collect::<Vec<_>>(),
+                "degree": clamped.degree(),
+                "knots": clamped.knots().knots(),
+                "control_points": points,
             }),
         );
     }

@@ -386,7 +386,10 @@ impl Fitter for GeometricSurfaceFitter {
     }
 
     fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Surface(&self.surface))
+        Some(Spline::Surface {
+            surface: &self.surface,
+            params: &self.uv,
+        })
     }
 
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {

@@ -403,7 +403,10 @@ impl Fitter for LsqSurfaceFitter {
     }
 
     fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Surface(&self.surface))
+        Some(Spline::Surface {
+            surface: &self.surface,
+            params: &self.uv,
+        })
     }
 
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {

@@ -1,0 +1,104 @@
+//! What a fit exports, for every engine alike: its spline as IGES/STEP, its surface as a mesh,
+//! its control net as OBJ. The command line and the JavaScript API both come here, so they
+//! refuse the same exports with the same messages.
+
+use super::{iges::write_iges, step::write_step, CurveDesc, ExportError, ExportModel, SurfaceDesc};
+use crate::fit::{Fitter, Shape, Spline};
+use crate::geom::Point3;
+use crate::mesh::PolyMesh;
+use crate::spline::BSplineSurface;
+
+/// Segments per patch edge of an exported surface mesh.
+pub const EXPORT_RESOLUTION: usize = 4;
+
+impl SurfaceDesc {
+    /// The description of `surface`.
+    pub fn from_surface(s: &BSplineSurface) -> SurfaceDesc {
+        let (num_u, num_v) = s.num_control();
+        SurfaceDesc {
+            degree_u: s.knots_u().degree(),
+            degree_v: s.knots_v().degree(),
+            knots_u: s.knots_u().knots().to_vec(),
+            knots_v: s.knots_v().knots().to_vec(),
+            num_u,
+            num_v,
+            control_points: s.control_points().to_vec(),
+            weights: s.weights().map(<[f64]>::to_vec),
+        }
+    }
+}
+
+/// The fitted spline of `fit` as an export model; subdivision surfaces have none.
+pub fn cad_model(fit: &dyn Fitter) -> Result<ExportModel, ExportError> {
+    let mut model = ExportModel::default();
+    match fit.spline() {
+        Some(Spline::Surface { surface, .. }) => {
+            model.surfaces.push(SurfaceDesc::from_surface(surface))
+        }
+        Some(Spline::Curve { curve, .. }) => model.curves.push(CurveDesc::from_curve(curve)?),
+        None => {
+            return Err(ExportError::Unsupported {
+                what: format!(
+                    "scheme {}: IGES and STEP export a B-spline; choose a B-spline surface or \
+                     curve scheme, or export the limit mesh",
+                    fit.scheme()
+                ),
+            })
+        }
+    }
+    Ok(model)
+}
+
+/// The fitted spline of `fit` as IGES 5.3 text named `name`.
+pub fn iges_of(fit: &dyn Fitter, name: &str) -> Result<String, ExportError> {
+    write_iges(&cad_model(fit)?, name)
+}
+
+/// The fitted spline of `fit` as STEP AP214 text named `name`.
+pub fn step_of(fit: &dyn Fitter, name: &str) -> Result<String, ExportError> {
+    write_step(&cad_model(fit)?, name)
+}
+
+/// The fitted surface tessellated for OBJ/PLY/STL ([`EXPORT_RESOLUTION`] segments per patch
+/// edge); a curve has none.
+pub fn surface_mesh(fit: &dyn Fitter) -> Result<PolyMesh, ExportError> {
+    match fit.limit_shape(EXPORT_RESOLUTION) {
+        Shape::Mesh(mesh) => Ok(mesh),
+        Shape::Polyline { .. } => Err(ExportError::Unsupported {
+            what: format!(
+                "scheme {}: a curve has no surface to export as a mesh; export IGES or STEP",
+                fit.scheme()
+            ),
+        }),
+    }
+}
+
+/// The control net as OBJ text: the cage of a subdivision surface (load it with the same
+/// scheme to get the surface), the control grid of a B-spline surface, or a curve's control
+/// polygon as an OBJ polyline (`l`).
+pub fn cage_obj(fit: &dyn Fitter) -> Result<Vec<u8>, ExportError> {
+    match fit.control_shape() {
+        Shape::Mesh(mesh) => crate::io::to_obj_bytes(&mesh).map_err(|e| ExportError::Unsupported {
+            what: e.to_string(),
+        }),
+        Shape::Polyline { points, closed } => Ok(polyline_obj(&points, closed).into_bytes()),
+    }
+}
+
+/// A polyline as OBJ text: its vertices and one `l` statement (back to the first when closed).
+fn polyline_obj(points: &[Point3], closed: bool) -> String {
+    let mut text = String::from("# geofit control polygon\n");
+    for p in points {
+        text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    let mut indices: Vec<usize> = (1..=points.len()).collect();
+    if closed && !points.is_empty() {
+        indices.push(1);
+    }
+    text.push('l');
+    for i in indices {
+        text.push_str(&format!(" {i}"));
+    }
+    text.push('\n');
+    text
+}
