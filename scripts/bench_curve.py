@@ -124,7 +124,7 @@ def geofit_fit(section, method, diag, points, tol):
         subprocess.run(["cargo", "build", "--release", "--bin", "geofit"], cwd=REPO, check=True)
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "r.json"
-        subprocess.run([str(exe), "fit-curve", str(section), "--closed", "--method", method,
+        subprocess.run([str(exe), "fit", str(section), "--scheme", "bspline-curve", "--quiet", "--closed", "--method", method,
                         "--tol-max", str(tol), "--json", str(out)], check=True)
         r = json.loads(out.read_text())
     c = r["clamped"]
@@ -134,7 +134,7 @@ def geofit_fit(section, method, diag, points, tol):
     poly = spline(np.linspace(a, b, 200_000))
     note = f"{r['iterations']} iterations, own E_max {r['e_max_pct']:.5f} %"
     if method == "knots":
-        note += f", {r['details']['corners']} corner / {r['details']['features']} multiple knots"
+        note += f", {r['corners']} corner / {r['features']} multiple knots"
         jumps = corner_jumps(spline, c["knots"], c["degree"])
         if jumps:
             note += f", tangent turns {min(jumps):.1f}–{max(jumps):.1f}° at the corner knots"

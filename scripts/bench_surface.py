@@ -184,7 +184,9 @@ def run_geofit(binary, data, extra, threads=1):
         env["GEOFIT_THREADS"] = str(threads)
     with tempfile.TemporaryDirectory() as tmp:
         sj = os.path.join(tmp, "s.json")
-        cmd = [binary, "fit", data, "--scheme", "bspline", "--surface-json", sj] + extra
+        rj = os.path.join(tmp, "r.json")
+        cmd = [binary, "fit", data, "--scheme", "bspline-surface", "--quiet", "--json", rj,
+               "--surface-json", sj] + extra
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         w = time.perf_counter()
         out = subprocess.run(cmd, capture_output=True, text=True, env=env)
@@ -192,7 +194,7 @@ def run_geofit(binary, data, extra, threads=1):
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         if out.returncode != 0:
             raise RuntimeError(out.stderr.strip())
-        report = json.loads(out.stdout)
+        report = json.load(open(rj))
         s = json.load(open(sj))
     ctrl = np.array(s["control_points"]).reshape(s["control_points_u"], s["control_points_v"], 3)
     surf = Surface(s["knots_u"], s["knots_v"], s["degree_u"], s["degree_v"], ctrl)

@@ -2,7 +2,8 @@
 //! insertion leaves the surface unchanged, foot points are orthogonal, bad input is typed.
 
 use geofit::geom::Point3;
-use geofit::spline::{BSplineSurface, KnotVector, NewtonOptions, SplineError};
+use geofit::geom::{ClosestPoint, NewtonOptions};
+use geofit::spline::{BSplineSurface, KnotVector, SplineError};
 use proptest::prelude::*;
 
 fn knots_u() -> KnotVector {
@@ -92,12 +93,13 @@ proptest! {
             let d = s.derivs(u, v, 1);
             let n = d.skl[1][0].cross(d.skl[0][1]).normalize();
             let q = d.point() + n * off;
-            let near = s.closest_point(q, (u + 0.03).min(1.0), (v - 0.03).max(0.0), NewtonOptions::default());
+            let near = s.closest_point_from(q, [(u + 0.03).min(1.0), (v - 0.03).max(0.0)], &NewtonOptions::DEFAULT);
             prop_assert!(near.converged);
-            prop_assert!(near.u.is_finite() && near.v.is_finite());
-            let dd = s.derivs(near.u, near.v, 1);
+            let [nu, nv] = near.param;
+            prop_assert!(nu.is_finite() && nv.is_finite());
+            let dd = s.derivs(nu, nv, 1);
             let r = q - near.point;
-            let interior = near.u > 0.0 && near.u < 1.0 && near.v > 0.0 && near.v < 1.0;
+            let interior = nu > 0.0 && nu < 1.0 && nv > 0.0 && nv < 1.0;
             if interior {
                 prop_assert!(r.dot(dd.skl[1][0]).abs() < 1e-9 * (1.0 + dd.skl[1][0].length()));
                 prop_assert!(r.dot(dd.skl[0][1]).abs() < 1e-9 * (1.0 + dd.skl[0][1].length()));
@@ -116,8 +118,8 @@ fn clamped_corners_interpolate() {
     assert!((s.eval(1.0, 0.0) - c[25]).length() < 1e-14);
     // Outside the domain is clamped, never NaN.
     assert!(s.eval(f64::NAN, 7.0).is_finite());
-    let near = s.closest_point(Point3::NAN, 0.5, 0.5, NewtonOptions::default());
-    assert!(near.u.is_finite() && near.v.is_finite());
+    let near = s.closest_point_from(Point3::NAN, [0.5, 0.5], &NewtonOptions::DEFAULT);
+    assert!(near.param.iter().all(|t| t.is_finite()));
 }
 
 #[test]

@@ -175,7 +175,7 @@ fn cli_fit_scheme_bspline_writes_the_report() {
         );
         let r: serde_json::Value =
             serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
-        assert_eq!(r["scheme"], "bspline");
+        assert_eq!(r["scheme"], "bspline-surface");
         assert_eq!(r["points"], 900);
         assert_eq!(r["control_points_u"], 6);
         assert_eq!(r["control_points_v"], 7);
@@ -212,7 +212,7 @@ fn cli_fit_scheme_bspline_writes_the_report() {
     for (args, message) in [
         (
             vec!["--scheme", "loop", "--method", "geometric"],
-            "--method applies to --scheme bspline only",
+            "--method does not apply to --scheme loop",
         ),
         (
             vec!["--scheme", "bspline", "--tol-avg", "0.01"],

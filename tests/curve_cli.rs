@@ -1,4 +1,4 @@
-//! `geofit fit-curve` end to end: report fields, exports, and clear failures on bad input.
+//! `geofit fit --scheme bspline-curve` end to end: report fields, exports, and clear failures on bad input.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -14,9 +14,11 @@ fn fit_curve_reports_and_exports() {
     for method in ["geometric", "knots"] {
         let json = dir.join(format!("{method}.json"));
         let out = Command::new(env!("CARGO_BIN_EXE_geofit"))
-            .arg("fit-curve")
+            .arg("fit")
             .arg(repo().join("tests/data/fandisk_section_x.xyz"))
             .args([
+                "--scheme",
+                "bspline-curve",
                 "--closed",
                 "--method",
                 method,
@@ -40,7 +42,7 @@ fn fit_curve_reports_and_exports() {
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
         assert_eq!(r["converged"], true, "{method}");
         assert!(r["e_max_pct"].as_f64().unwrap() <= 0.01);
-        assert!(r["control_points"].as_u64().unwrap() >= 4);
+        assert!(r["final_control_points"].as_u64().unwrap() >= 4);
         assert_eq!(r["samples"].as_array().unwrap().len(), 101);
         assert!(!r["history"].as_array().unwrap().is_empty());
         assert!(dir.join(format!("{method}.igs")).exists());
@@ -56,7 +58,7 @@ fn fit_curve_fails_cleanly_on_bad_input() {
     let bad = dir.join("three.xyz");
     std::fs::write(&bad, "0 0\n1 0\n1 1\n").unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_geofit"))
-        .arg("fit-curve")
+        .args(["fit", "--scheme", "bspline-curve"])
         .arg(&bad)
         .output()
         .unwrap();
@@ -64,7 +66,7 @@ fn fit_curve_fails_cleanly_on_bad_input() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("too few data points"), "{err}");
     let out = Command::new(env!("CARGO_BIN_EXE_geofit"))
-        .args(["fit-curve"])
+        .args(["fit", "--scheme", "bspline-curve"])
         .arg(repo().join("tests/data/bunny_section.xyz"))
         .args(["--degree", "9"])
         .output()

@@ -184,16 +184,16 @@ fn closest_point_residual_is_normal_to_the_curve() {
         for i in 0..20 {
             let q = Point3::new(1.5 * (i as f64).cos(), 1.2 * (i as f64 * 0.7).sin(), 0.1);
             let near = c.closest_point(q, 16);
-            let d = c.eval_derivs(near.u, 1);
+            let d = c.eval_derivs(near.param, 1);
             let (a, b) = c.domain();
-            let at_end = !c.is_closed() && (near.u == a || near.u == b);
+            let at_end = !c.is_closed() && (near.param == a || near.param == b);
             let cos = (q - d[0]).normalize_or_zero().dot(d[1].normalize_or_zero());
             assert!(
                 at_end || cos.abs() < 1e-6 || near.dist_sq < 1e-20,
                 "degree {} closed {}: cos {cos} at u {} ({:?})",
                 c.degree(),
                 c.is_closed(),
-                near.u,
+                near.param,
                 near
             );
         }

@@ -1,17 +1,13 @@
 //! Fitting bare point clouds end to end: points without faces are reconstructed into a mesh
 //! (open or closed), simplified by QEM and fitted, through the library entry point
-//! `build_subdiv_fitter` and through `geofit fit`; degenerate clouds give clear errors.
+//! `FitSpec::build` and through `geofit fit`; degenerate clouds give clear errors.
 
 mod common;
 
 use common::Rng;
-use geofit::cloud::ReconstructOptions;
-use geofit::fit::{
-    build_subdiv_fitter, FitError, FitReport, FitStatus, Fitter, SubdivFitOptions, Tolerances,
-};
+use geofit::fit::{FitData, FitError, FitReport, FitSpec, FitStatus, Scheme};
 use geofit::geom::Point3;
 use geofit::mesh::PolyMesh;
-use geofit::subdiv::Scheme;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -44,14 +40,11 @@ fn noisy_sheet() -> Vec<Point3> {
     points
 }
 
-fn options(avg: f64, max: f64) -> SubdivFitOptions {
-    SubdivFitOptions::default()
-        .with_tolerances(Tolerances {
-            avg_pct: Some(avg),
-            max_pct: Some(max),
-            rms_pct: None,
-        })
-        .with_max_iter(40)
+fn spec(avg: f64, max: f64) -> FitSpec {
+    FitSpec::new(Scheme::Loop)
+        .with_tol_avg(Some(avg))
+        .with_tol_max(Some(max))
+        .with_max_iter(Some(40))
         .with_max_control(Some(1_000))
 }
 
@@ -62,20 +55,17 @@ fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
     let twice: Vec<Point3> = points.iter().step_by(10).copied().collect();
     points.extend(twice);
     let data = PolyMesh::from_points(points.clone()).expect("finite points");
-    let setup = build_subdiv_fitter(
-        &data,
-        None,
-        &ReconstructOptions::default(),
-        Scheme::Loop,
-        None,
-        Some(80),
-        options(0.05, 0.3),
-    )
-    .expect("a fitter");
-    let rec = setup.reconstruction.clone().expect("reconstructed");
+    let mut fitter = spec(0.05, 0.3)
+        .with_initial(Some(80))
+        .build(&FitData::points(&data))
+        .expect("a fitter");
+    let rec = fitter
+        .log()
+        .reconstruction()
+        .cloned()
+        .expect("reconstructed");
     assert_eq!((rec.kind, rec.method), ("closed", "implicit"));
     assert!(rec.triangles > 500, "{rec:?}");
-    let mut fitter = setup.fitter;
     assert_eq!(
         fitter.data().len(),
         points.len(),
@@ -89,7 +79,7 @@ fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
         stats.e_avg_pct <= 0.05 && stats.e_max_pct <= 0.3,
         "{stats:?}"
     );
-    let report = FitReport::of(&fitter, 0.0, 0.0);
+    let report = FitReport::of(fitter.as_ref());
     assert_eq!(report.within_tolerance_pct, Some(100.0));
 }
 
@@ -97,21 +87,16 @@ fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
 fn open_noisy_cloud_drops_outliers_and_reports_the_share_within_tolerance() {
     let points = noisy_sheet();
     let data = PolyMesh::from_points(points.clone()).expect("finite points");
-    let cloud = ReconstructOptions::default().with_outlier_std_ratio(Some(3.0));
-    let setup = build_subdiv_fitter(
-        &data,
-        None,
-        &cloud,
-        Scheme::Loop,
-        None,
-        None,
-        options(0.1, 0.5),
-    )
-    .expect("a fitter");
-    let rec = setup.reconstruction.clone().expect("reconstructed");
+    let mut spec = spec(0.1, 0.5);
+    spec.outliers = Some(3.0);
+    let mut fitter = spec.build(&FitData::points(&data)).expect("a fitter");
+    let rec = fitter
+        .log()
+        .reconstruction()
+        .cloned()
+        .expect("reconstructed");
     assert_eq!((rec.kind, rec.method), ("open", "delaunay"));
     assert_eq!(rec.outliers, 2, "{rec:?}");
-    let mut fitter = setup.fitter;
     assert_eq!(
         fitter.data().len(),
         points.len() - 2,
@@ -119,7 +104,7 @@ fn open_noisy_cloud_drops_outliers_and_reports_the_share_within_tolerance() {
     );
     let status = fitter.run().expect("iterates");
     assert_eq!(status, FitStatus::Converged, "{:?}", fitter.stats());
-    let within = FitReport::of(&fitter, 0.0, 0.0)
+    let within = FitReport::of(fitter.as_ref())
         .within_tolerance_pct
         .expect("an E_max tolerance was given");
     assert!((99.0..=100.0).contains(&within), "{within}");
@@ -131,20 +116,13 @@ fn a_control_mesh_for_points_needs_no_reconstruction_only_when_given() {
     // Without the reconstruction, simplification alone cannot start from bare points.
     assert!(matches!(
         geofit::fit::initial_control(&data, Some(50)),
-        Err(FitError::ControlMesh { .. })
+        Err(FitError::NoFaces)
     ));
     let two = PolyMesh::from_points(ellipsoid(2)).expect("finite points");
-    let err = build_subdiv_fitter(
-        &two,
-        None,
-        &ReconstructOptions::default(),
-        Scheme::Loop,
-        None,
-        None,
-        SubdivFitOptions::default(),
-    )
-    .err()
-    .expect("two points span no surface");
+    let err = FitSpec::new(Scheme::Loop)
+        .build(&FitData::points(&two))
+        .err()
+        .expect("two points span no surface");
     assert!(matches!(err, FitError::Reconstruct(_)), "{err}");
 }
 

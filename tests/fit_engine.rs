@@ -165,7 +165,7 @@ fn refinement_stays_manifold_conforming_and_within_budget() {
     );
     let mesh = fitter.control_mesh();
     assert!(mesh.num_vertices() <= 400);
-    geofit::fit::refine::check_manifold(&mesh).expect("manifold");
+    geofit::mesh::check_oriented_edges(&mesh).expect("manifold");
     // Closed and conforming: every edge has exactly two faces, and V − E + F = 2.
     let mut edges = std::collections::HashMap::new();
     for f in mesh.faces() {

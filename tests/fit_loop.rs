@@ -74,7 +74,7 @@ fn loop_refinement_with_flips_stays_manifold_and_finite() {
     assert!(fitter.point_errors().iter().all(|e| e.is_finite()));
     assert!(fitter.stats().e_rms_pct < 0.5 * first);
     let mesh = fitter.control_mesh();
-    geofit::fit::refine::check_manifold(&mesh).expect("manifold");
+    geofit::mesh::check_oriented_edges(&mesh).expect("manifold");
     geofit::mesh::ControlMesh::try_new(&mesh).expect("valid control mesh");
 }
 
@@ -83,7 +83,7 @@ fn loop_refinement_with_flips_stays_manifold_and_finite() {
 /// surface there (on this very coarse mesh by a few %); the following iterations absorb it.
 #[test]
 fn loop_split_keeps_the_limit_surface() {
-    use geofit::fit::refine::{split_triangles, SplitRule};
+    use geofit::subdiv::adaptive::{split_triangles, SplitRule};
     let control = perturbed(&sphere_mesh(1), 0.1, &mut Rng(31));
     let truth = surface_of(Scheme::Loop, &control).expect("surface");
     let data = sample(&truth, 20, &mut Rng(32));

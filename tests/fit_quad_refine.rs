@@ -6,11 +6,11 @@ mod common;
 
 use common::meshes::{cube, quad_grid};
 use common::{sphere_mesh, Rng};
-use geofit::fit::refine::check_manifold;
-use geofit::fit::refine_quad::split_quads;
 use geofit::fit::{surface_of, Fitter, SubdivFitOptions, SubdivFitter, Tolerances};
 use geofit::geom::Point3;
+use geofit::mesh::check_oriented_edges;
 use geofit::mesh::PolyMesh;
+use geofit::subdiv::adaptive::split_quads;
 use geofit::subdiv::{LimitSurface, Scheme, SubdivSurface, SurfaceParam};
 use proptest::prelude::*;
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -32,7 +32,7 @@ fn edge_counts(mesh: &PolyMesh) -> BTreeMap<(u32, u32), usize> {
 /// edge), finite points, and the marked quads are gone.
 fn assert_conforming_refinement(old: &PolyMesh, new: &PolyMesh, marked: &[bool]) {
     assert!(new.faces().all(|f| f.len() == 4), "not all quads");
-    check_manifold(new).expect("oriented manifold");
+    check_oriented_edges(new).expect("oriented manifold");
     assert!(edge_counts(new).values().all(|&n| n <= 2));
     assert!(new.positions().iter().all(|p| p.is_finite()));
     let old_rim: Vec<(u32, u32)> = edge_counts(old)
@@ -220,7 +220,7 @@ fn fit_converges_further_with_local_refinement() {
         "refined {b:?} vs plain {a:?}"
     );
     let mesh = refined.control_mesh();
-    check_manifold(&mesh).expect("manifold");
+    check_oriented_edges(&mesh).expect("manifold");
     assert!(mesh.faces().all(|f| f.len() == 4));
 }
 

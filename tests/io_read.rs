@@ -4,6 +4,7 @@
 mod common;
 
 use common::test_file;
+use geofit::fit::FitData;
 use geofit::io::{read_bytes, read_path, Format, Location, ReadError};
 
 fn err(bytes: &[u8], name: Option<&str>) -> ReadError {
@@ -183,21 +184,22 @@ fn malformed_sample_files() {
 #[test]
 fn curve_points_follow_the_longest_polyline_and_see_it_closed() {
     let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 9 9 9\nl 1 2\nl 1 2 3 4 1\n";
-    let (points, closed) = read_bytes(obj, Some("c.obj")).expect("obj").curve_points();
+    let (points, closed) =
+        FitData::from(&read_bytes(obj, Some("c.obj")).expect("obj")).curve_points();
     assert!(closed);
     assert_eq!(points.len(), 4, "the repeated first vertex is given once");
     assert_eq!(points[2].to_array(), [1.0, 1.0, 0.0]);
     let open = b"v 0 0 0\nv 1 0 0\nv 2 1 0\nl 3 2 1\n";
-    let (points, closed) = read_bytes(open, Some("o.obj")).expect("obj").curve_points();
+    let (points, closed) =
+        FitData::from(&read_bytes(open, Some("o.obj")).expect("obj")).curve_points();
     assert!(!closed);
     assert_eq!(
         points[0].to_array(),
         [2.0, 1.0, 0.0],
         "polyline order, not file order"
     );
-    let (points, closed) = read_bytes(b"0 0 0\n1 0 0\n2 0 0\n", Some("p.xyz"))
-        .expect("xyz")
-        .curve_points();
+    let file = read_bytes(b"0 0 0\n1 0 0\n2 0 0\n", Some("p.xyz")).expect("xyz");
+    let (points, closed) = FitData::from(&file).curve_points();
     assert_eq!(
         (points.len(), closed),
         (3, false),

@@ -1,8 +1,8 @@
 //! Smoothed least-squares B-spline surface fitting (SPEC §2): exact reproduction, smoothing
 //! monotonicity, parameter correction, adaptive splitting, fold detection and typed errors.
 
-use geofit::fit::lsq_surface::energies;
-use geofit::fit::parameterize::{parameterize, parameterize_on_surface};
+use geofit::fit::energies;
+use geofit::fit::{parameterize, parameterize_on_surface};
 use geofit::fit::{
     FitError, FitStatus, Fitter, FoldPolicy, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions,
     Parameterization, TolMode,

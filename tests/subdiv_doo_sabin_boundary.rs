@@ -7,8 +7,8 @@
 mod common;
 
 use common::meshes::{jitter, quad_grid, tri_grid};
-use geofit::fit::closest::closest_point;
-use geofit::fit::options::NewtonOptions;
+use geofit::fit::SubdivFitOptions;
+use geofit::geom::ClosestPoint;
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::{ControlMesh, PolyMesh};
 use geofit::subdiv::{refine, DooSabinSurface, LimitSurface, Scheme, SurfaceParam};
@@ -189,7 +189,7 @@ fn derivatives_match_finite_differences_on_open_meshes() {
 /// parameter walks across the patch edge (and across boundary patches).
 #[test]
 fn newton_walks_into_neighbouring_patches() {
-    let opts = NewtonOptions::default();
+    let opts = SubdivFitOptions::DEFAULT.newton;
     for mesh in test_meshes() {
         let s = DooSabinSurface::try_new(&mesh).unwrap();
         let mut crossed = 0;
@@ -208,7 +208,7 @@ fn newton_walks_into_neighbouring_patches() {
                     u: 0.5,
                     v: 0.5,
                 };
-                let foot = closest_point(&s, target, start, &opts, 1.0);
+                let foot = s.closest_point_from(target, start, &opts);
                 assert!(foot.converged, "patch {patch} side {j}");
                 assert!(
                     (foot.point - e.point).length() < 1e-7,
@@ -306,7 +306,7 @@ fn crease_tags_keep_a_sharp_edge() {
 /// surface lie on the refined one.
 #[test]
 fn refinement_keeps_the_limit_surface_at_boundaries_and_creases() {
-    let opts = NewtonOptions::default();
+    let opts = SubdivFitOptions::DEFAULT.newton;
     for (mesh, n) in test_meshes().into_iter().zip([4, 3, 4]) {
         let mut cm = ControlMesh::try_new(&mesh).unwrap();
         // Tag the grid line x = 2 as a crease (from boundary to boundary).
@@ -334,7 +334,7 @@ fn refinement_keeps_the_limit_surface_at_boundaries_and_creases() {
                 let foot = near
                     .iter()
                     .take(8)
-                    .map(|&&(_, start)| closest_point(&s1, x, start, &opts, 1.0))
+                    .map(|&&(_, start)| s1.closest_point_from(x, start, &opts))
                     .min_by(|a, b| a.dist_sq.total_cmp(&b.dist_sq))
                     .unwrap();
                 assert!(

@@ -5,9 +5,9 @@
 mod common;
 
 use common::{bump_grid, perturbed, sphere_mesh, Rng};
-use geofit::fit::refine::{improve_by_flips, split_triangles, SplitRule};
-use geofit::fit::refine_quad::split_quads;
 use geofit::mesh::{ControlMesh, PolyMesh};
+use geofit::subdiv::adaptive::split_quads;
+use geofit::subdiv::adaptive::{improve_by_flips, split_triangles, SplitRule};
 use geofit::subdiv::{quadrangulate, LimitSurface, Scheme, SubdivSurface, SurfaceParam};
 
 /// Parameters inside a patch, on its edges and at its corners (for triangles, u + v ≤ 1).

@@ -1,11 +1,11 @@
+// @ts-check
 // The fitting worker: owns a geofit `Fitter` and iterates it off the main thread. After every
 // `run(budget)` slice (at least one iteration, at most ~40 ms of work when iterations are fast) it
-// posts a frame: statistics, history, signed point errors, the limit mesh (or curve), the
-// control-net edges, the error vectors and iso-parameter lines, all as transferable typed arrays.
-// Messages in: start, play, pause, step, export, clear. Messages out: frame, exported, error
-// (each with the `generation` of the fit it belongs to, so that the page can drop what an older
-// fit sent).
+// posts a frame (see protocol.js): statistics, history, signed point errors, the limit mesh (or
+// curve), the control-net edges, the error vectors and iso-parameter lines, all as transferable
+// typed arrays.
 import init, { Fitter, loadFile } from '../pkg/geofit.js';
+import { MSG, frameTransfers } from './protocol.js';
 
 const SLICE_MS = 40;
 // Segments per patch edge of the drawn limit surface: fewer while the fit runs (a frame every
@@ -16,6 +16,7 @@ const RUNNING_RESOLUTION = 2;
 const MAX_TRIANGLES = 40_000;
 let resolution = LIMIT_RESOLUTION;
 
+/** @type {Fitter | null} */
 let fitter = null;
 let playing = false;
 let generation = 0;
@@ -23,46 +24,45 @@ const ready = init();
 
 function fail(error, during) {
   playing = false;
-  postMessage({ type: 'error', during, generation, message: String(error?.message ?? error) });
+  postMessage({ type: MSG.error, during, generation, message: String(error?.message ?? error) });
 }
 
-/** Posts the current state of the fit; typed arrays move to the main thread without copying. */
-function postFrame(kind) {
-  const running = playing && fitter.stats().status === 'running';
-  let limit = fitter.limitMesh(running ? Math.min(resolution, RUNNING_RESOLUTION) : resolution);
+/**
+ * Posts the current state of the fit; typed arrays move to the main thread without copying.
+ * @param {Fitter} f
+ * @param {'start' | 'play' | 'pause' | 'step'} kind
+ */
+function postFrame(f, kind) {
+  const running = playing && f.stats().status === 'running';
+  let limit = f.limitMesh(running ? Math.min(resolution, RUNNING_RESOLUTION) : resolution);
   while (limit.indices.length > 3 * MAX_TRIANGLES && resolution > 1) {
     limit.free();
     resolution -= 1;
-    limit = fitter.limitMesh(resolution);
+    limit = f.limitMesh(resolution);
   }
-  const control = fitter.controlMesh();
+  const control = f.controlMesh();
+  /** @type {import('./protocol.js').FrameMessage} */
   const frame = {
-    type: 'frame',
+    type: MSG.frame,
     kind,
     generation,
     playing,
-    stats: fitter.stats(),
-    history: fitter.history(),
-    errors: fitter.pointErrors(),
+    stats: f.stats(),
+    history: f.history(),
+    errors: f.pointErrors(),
     limit: { positions: limit.positions, normals: limit.normals, indices: limit.indices, edges: limit.edges },
     control: { positions: control.positions, edges: control.edges },
-    vectors: fitter.errorVectors(),
-    iso: fitter.isoLines(resolution),
+    vectors: f.errorVectors(),
+    iso: f.isoLines(resolution),
   };
   limit.free();
   control.free();
-  const transfer = [
-    frame.errors, frame.limit.positions, frame.limit.normals, frame.limit.indices, frame.limit.edges,
-    frame.control.positions, frame.control.edges, frame.vectors, frame.iso,
-  ];
-  // Sent once per fit: the data points (in the order of `errors`) and the initial control net.
   if (kind === 'start') {
-    const initial = fitter.initialMesh();
-    frame.once = { data: fitter.dataPositions(), initial: { positions: initial.positions, edges: initial.edges } };
+    const initial = f.initialMesh();
+    frame.once = { data: f.dataPositions(), initial: { positions: initial.positions, edges: initial.edges } };
     initial.free();
-    transfer.push(frame.once.data, frame.once.initial.positions, frame.once.initial.edges);
   }
-  postMessage(frame, transfer.map((a) => a.buffer));
+  postMessage(frame, frameTransfers(frame));
 }
 
 /** Iterates slice by slice while playing, yielding to the message queue between slices. */
@@ -76,57 +76,60 @@ function play(gen) {
     return;
   }
   if (stats.status !== 'running') playing = false;
-  postFrame('play');
+  postFrame(fitter, 'play');
   if (playing) setTimeout(() => play(gen), 0);
 }
 
+/** The exports, by the names `exportsFor(scheme)` gives. */
+const EXPORTS = {
+  cage: (f) => f.exportCage(),
+  obj: (f) => f.exportObj(),
+  ply: (f) => f.exportPly(),
+  stl: (f) => f.exportStl(),
+  iges: (f) => f.exportIges(),
+  step: (f) => f.exportStep(),
+  json: (f) => new TextEncoder().encode(f.reportJson()),
+};
+
 const handlers = {
-  start({ generation: gen, bytes, name, options }) {
-    handlers.clear({ generation: gen });
+  [MSG.start]({ generation: gen, bytes, name, spec }) {
+    handlers[MSG.clear]({ generation: gen });
     const scan = loadFile(bytes, name);
     try {
-      fitter = new Fitter(scan, options);
+      fitter = new Fitter(scan, spec);
     } finally {
       scan.free();
     }
-    postFrame('start');
+    postFrame(fitter, 'start');
   },
-  clear({ generation: gen }) {
+  [MSG.clear]({ generation: gen }) {
     playing = false;
     resolution = LIMIT_RESOLUTION;
     generation = gen ?? generation + 1;
     fitter?.free();
     fitter = null;
   },
-  play() {
+  [MSG.play]() {
     if (!fitter || playing) return;
     playing = true;
     play(generation);
   },
-  pause() {
+  [MSG.pause]() {
     playing = false;
-    if (fitter) postFrame('pause');
+    if (fitter) postFrame(fitter, 'pause');
   },
-  step() {
+  [MSG.step]() {
     if (!fitter) return;
     playing = false;
     fitter.step();
-    postFrame('step');
+    postFrame(fitter, 'step');
   },
-  export({ what }) {
+  [MSG.export]({ what }) {
     if (!fitter) throw new Error('nothing is fitted yet');
-    const make = {
-      cage: () => fitter.exportCage(),
-      obj: () => fitter.exportObj(),
-      ply: () => fitter.exportPly(),
-      stl: () => fitter.exportStl(),
-      iges: () => fitter.exportIges(),
-      step: () => fitter.exportStep(),
-      json: () => new TextEncoder().encode(fitter.reportJson()),
-    }[what];
+    const make = EXPORTS[what];
     if (!make) throw new Error(`unknown export '${what}'`);
-    const bytes = make();
-    postMessage({ type: 'exported', what, bytes }, [bytes.buffer]);
+    const bytes = make(fitter);
+    postMessage({ type: MSG.exported, what, bytes }, [bytes.buffer]);
   },
 };
 

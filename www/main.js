@@ -4,12 +4,9 @@
 import init, { Viewer, loadFile } from '../pkg/geofit.js';
 import { createFitUi } from './fit-ui.js';
 
-// Bundled samples (www/samples/) and the fit settings that suit each.
-const SAMPLE_PRESETS = {
-  'bunny.obj': { scheme: 'loop', tolMax: 0.5 },
-  'bun000-points.xyz': { scheme: 'bspline-surface', tolMax: 0.5 },
-  'bunny-section.xyz': { scheme: 'bspline-curve', closed: true, tolMax: 0.1 },
-};
+// The bundled samples (www/samples/samples.json): file, label and the fit options that suit
+// each, by file name.
+let samplePresets = {};
 // Height colours, low to high (sRGB): blue, teal, amber.
 const PALETTE = [
   [0.15, 0.35, 0.95],
@@ -118,7 +115,7 @@ function show(bytes, name) {
     clearError();
     setState('ready');
     requestRender();
-    fitUi?.onScan(bytes, name, diagonal(scan), SAMPLE_PRESETS[name]);
+    fitUi?.onScan(bytes, name, diagonal(scan), samplePresets[name]);
     return true;
   } catch (e) {
     showError(`Could not show ${name}: ${e?.message ?? e}`);
@@ -244,6 +241,8 @@ async function main() {
   bindFiles();
   bindCamera();
   fitUi = createFitUi({ viewer: () => viewer, requestRender, showError, canvas: ui.canvas });
+  // Test hook (read by tests/e2e, not an API): the fitting panel's figures.
+  window.geofitFit = fitUi.figures;
   for (const box of [ui.showPoints, ui.showMesh, ui.showWireframe, ui.showZebra]) {
     box.addEventListener('change', updateLayers);
   }
@@ -253,7 +252,7 @@ async function main() {
   try {
     viewer = await Viewer.create(ui.canvas);
     ui.backend.textContent = viewer.backend;
-    // A handle for the browser console and the end-to-end tests.
+    // Test hook (read by tests/e2e and handy in the console, not an API).
     window.geofit = { viewer, loadFile, requestRender };
     document.body.dataset.backend = viewer.backend;
   } catch (e) {
@@ -264,8 +263,18 @@ async function main() {
   window.addEventListener('resize', resize);
   resize();
   updateLayers();
+  await listSamples();
   ui.sample.addEventListener('change', () => openSample(ui.sample.value));
   await openSample(ui.sample.value);
+}
+
+/** Fills the sample list from the manifest; the first sample opens at start. */
+async function listSamples() {
+  const response = await fetch('samples/samples.json');
+  if (!response.ok) throw new Error(`samples/samples.json: HTTP ${response.status}`);
+  const { samples } = await response.json();
+  ui.sample.replaceChildren(...samples.map((s) => new Option(s.label, s.file)));
+  samplePresets = Object.fromEntries(samples.map((s) => [s.file, s.preset]));
 }
 
 /** Fetches a bundled sample from www/samples/ and shows it. */

@@ -3,10 +3,22 @@
 //! refuse the same exports with the same messages.
 
 use super::{iges::write_iges, step::write_step, CurveDesc, ExportError, ExportModel, SurfaceDesc};
-use crate::fit::{Fitter, Shape, Spline};
+use crate::fit::{Fitter, Scheme, Shape, Spline};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use crate::spline::BSplineSurface;
+
+/// The exports a fit of `scheme` offers: `cage` and `json` always, `obj`/`ply`/`stl` for
+/// surfaces, `iges`/`step` for B-splines.
+pub fn exports_for(scheme: Scheme) -> &'static [&'static str] {
+    match scheme {
+        Scheme::Loop | Scheme::CatmullClark | Scheme::DooSabin => {
+            &["cage", "obj", "ply", "stl", "json"]
+        }
+        Scheme::BsplineSurface => &["cage", "obj", "ply", "stl", "iges", "step", "json"],
+        Scheme::BsplineCurve | Scheme::ChaikinCurve => &["cage", "iges", "step", "json"],
+    }
+}
 
 /// Segments per patch edge of an exported surface mesh.
 pub const EXPORT_RESOLUTION: usize = 4;

@@ -11,7 +11,9 @@ mod fitted;
 pub mod iges;
 pub mod step;
 
-pub use fitted::{cad_model, cage_obj, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION};
+pub use fitted::{
+    cad_model, cage_obj, exports_for, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION,
+};
 
 use crate::geom::Point3;
 use crate::spline::{BSplineCurve, KnotVector, SplineError};

@@ -10,7 +10,7 @@
 //! | `subdiv` | [`SubdivFitter`]: Loop, Catmull–Clark and Doo–Sabin limit surfaces (SPEC §1) |
 //! | `surface` | [`GeometricSurfaceFitter`], [`LsqSurfaceFitter`]: one B-spline surface (SPEC §1, §2) |
 //! | `curve` | [`CurveFitter`], [`KnotPlacementFitter`]: B-spline curves (SPEC §1.9, §3) |
-//! | `log` | [`FitLog`]: the history and status bookkeeping every engine shares |
+//! | `state`, `log` | [`FitState`], [`FitLog`]: data, errors, history and status, kept alike by every engine |
 //! | `report` | [`FitReport`]: the machine-readable summary of any fit |
 
 mod accel;
@@ -20,6 +20,7 @@ mod log;
 mod parallel;
 mod report;
 mod spec;
+mod state;
 mod stats;
 mod subdiv;
 mod surface;
@@ -33,6 +34,7 @@ pub use error::FitError;
 pub use log::FitLog;
 pub use report::{within_tolerance_pct, FitReport};
 pub use spec::{Cloud, FitData, FitSpec, Method, OptionInfo, Scheme, OPTION_TABLE};
+pub use state::FitState;
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
 pub use subdiv::{
     default_initial_count, initial_control, surface_of, ControlSurface, ReconstructionReport,
@@ -40,8 +42,8 @@ pub use subdiv::{
 };
 pub use surface::{
     energies, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
-    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions,
-    Parameterization, SurfaceGrid, TolMode,
+    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, Parameterization,
+    SurfaceGrid, TolMode,
 };
 
 use crate::geom::Point3;
@@ -110,18 +112,32 @@ pub trait Fitter {
         }
     }
 
+    /// Data, errors, tolerances, scheme and method, history and status.
+    fn state(&self) -> &FitState;
+
+    /// The state, for builders that add what they did before the engine existed (reading,
+    /// meshing, simplification) to its set-up time and intake.
+    fn state_mut(&mut self) -> &mut FitState;
+
     /// The scheme this engine fits.
-    fn scheme(&self) -> Scheme;
+    fn scheme(&self) -> Scheme {
+        self.state().scheme()
+    }
 
     /// The method it fits with.
-    fn method(&self) -> Method;
+    fn method(&self) -> Method {
+        self.state().method()
+    }
 
     /// History, status, set-up time and intake of the fit.
-    fn log(&self) -> &FitLog;
+    fn log(&self) -> &FitLog {
+        self.state().log()
+    }
 
-    /// The log, for builders that add what they did before the engine existed (reading,
-    /// meshing, simplification) to its set-up time and intake.
-    fn log_mut(&mut self) -> &mut FitLog;
+    /// The log, for builders (see [`Fitter::state_mut`]).
+    fn log_mut(&mut self) -> &mut FitLog {
+        self.state_mut().log_mut()
+    }
 
     /// Where the fit stands after the last step.
     fn status(&self) -> FitStatus {
@@ -134,20 +150,30 @@ pub trait Fitter {
     }
 
     /// The tolerances the fit stops at (% of the bounding-box diagonal).
-    fn tolerances(&self) -> Tolerances;
+    fn tolerances(&self) -> Tolerances {
+        self.state().tolerances()
+    }
 
     /// The data points, in the order of [`Fitter::point_errors`].
-    fn data(&self) -> &[Point3];
+    fn data(&self) -> &[Point3] {
+        self.state().data()
+    }
 
     /// Bounding-box diagonal of the data: what the `_pct` figures are relative to.
-    fn diagonal(&self) -> f64;
+    fn diagonal(&self) -> f64 {
+        self.state().diagonal()
+    }
 
     /// Signed distance of every data point to the current surface or curve, in model units
     /// (positive on the side the surface normal points to), in data order.
-    fn point_errors(&self) -> &[f64];
+    fn point_errors(&self) -> &[f64] {
+        self.state().errors()
+    }
 
     /// Error statistics of the current surface or curve.
-    fn stats(&self) -> ErrorStats;
+    fn stats(&self) -> ErrorStats {
+        self.state().stats()
+    }
 
     /// The point of the surface or curve each data point is measured to, in data order.
     fn foot_points(&self) -> Vec<Point3>;
@@ -175,8 +201,8 @@ pub trait Fitter {
         None
     }
 
-    /// What only this engine reports (control grid, fold-overs, features), as JSON fields
-    /// that [`FitReport`] lists under `details`.
+    /// What only this engine reports (control grid, fold-overs, features, curve samples), as
+    /// JSON fields that [`FitReport`] writes beside the common ones.
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {
         serde_json::Map::new()
     }

@@ -42,7 +42,8 @@ pub struct FitReport {
     pub fit_s: f64,
     /// `precompute_s + fit_s`.
     pub total_s: f64,
-    /// What only this engine reports ([`Fitter::details`]).
+    /// What only this engine reports ([`Fitter::details`]), written beside the common fields.
+    #[serde(flatten)]
     pub details: serde_json::Map<String, serde_json::Value>,
     /// One record per iteration.
     pub history: Vec<IterationRecord>,

@@ -286,14 +286,15 @@ pub struct OptionInfo {
 impl OptionInfo {
     /// Whether the option takes part in a fit of `scheme` by `method`.
     pub fn applies(&self, scheme: Scheme, method: Method) -> bool {
-        self.schemes.contains(&scheme) && (self.methods.is_empty() || self.methods.contains(&method))
+        self.schemes.contains(&scheme)
+            && (self.methods.is_empty() || self.methods.contains(&method))
     }
 }
 
 use Method::{Geometric as GEO, KnotPlacement as KNOTS, LeastSquares as LSQ};
 use Scheme::{
-    BsplineCurve as BC, BsplineSurface as BS, CatmullClark as CC, ChaikinCurve as CH, DooSabin as DS,
-    Loop as LP,
+    BsplineCurve as BC, BsplineSurface as BS, CatmullClark as CC, ChaikinCurve as CH,
+    DooSabin as DS, Loop as LP,
 };
 const ALL: &[Scheme] = &[LP, CC, DS, BS, BC, CH];
 const SUBDIV: &[Scheme] = &[LP, CC, DS];
@@ -315,33 +316,135 @@ macro_rules! info {
 /// Every field of [`FitSpec`] with where it applies: the one table of option applicability.
 pub const OPTION_TABLE: &[OptionInfo] = &[
     info!("scheme", "scheme", ALL, &[], "what is fitted"),
-    info!("method", "method", &[BS, BC, CH], &[], "how control points are found"),
-    info!("tolAvg", "tol-avg", NOT_SURFACE, &[], "tolerance on E_avg, % of the diagonal"),
-    info!("tolMax", "tol-max", ALL, &[], "tolerance on E_max, % of the diagonal"),
-    info!("tolRms", "tol-rms", NOT_SURFACE, &[], "tolerance on E_rms, % of the diagonal"),
-    info!("initial", "initial", &[LP, CC, DS, BS], &[], "initial control points"),
+    info!(
+        "method",
+        "method",
+        &[BS, BC, CH],
+        &[],
+        "how control points are found"
+    ),
+    info!(
+        "tolAvg",
+        "tol-avg",
+        NOT_SURFACE,
+        &[],
+        "tolerance on E_avg, % of the diagonal"
+    ),
+    info!(
+        "tolMax",
+        "tol-max",
+        ALL,
+        &[],
+        "tolerance on E_max, % of the diagonal"
+    ),
+    info!(
+        "tolRms",
+        "tol-rms",
+        NOT_SURFACE,
+        &[],
+        "tolerance on E_rms, % of the diagonal"
+    ),
+    info!(
+        "initial",
+        "initial",
+        &[LP, CC, DS, BS],
+        &[],
+        "initial control points"
+    ),
     info!("grid", "ctrl-u", &[BS], &[], "control points along u and v"),
     info!("maxIter", "max-iter", ALL, &[], "iteration cap"),
-    info!("refine", "no-refine", ALL, &[GEO, LSQ], "refine where the tolerance is missed"),
-    info!("maxControl", "max-control", ALL, &[GEO, LSQ], "control-point budget of refinement"),
+    info!(
+        "refine",
+        "no-refine",
+        ALL,
+        &[GEO, LSQ],
+        "refine where the tolerance is missed"
+    ),
+    info!(
+        "maxControl",
+        "max-control",
+        ALL,
+        &[GEO, LSQ],
+        "control-point budget of refinement"
+    ),
     info!("weights", "weights", SUBDIV, &[], "error-vector weighting"),
-    info!("acceleration", "accel", ALL, &[GEO], "acceleration of the iteration"),
-    info!("tangentWeight", "tangent-weight", SUBDIV, &[], "CG: tangential error weight"),
-    info!("refineGrowth", "refine-growth", SUBDIV, &[], "largest growth of one refinement"),
-    info!("remesh", "no-remesh", SUBDIV, &[], "edge flips after a refinement (Loop)"),
+    info!(
+        "acceleration",
+        "accel",
+        ALL,
+        &[GEO],
+        "acceleration of the iteration"
+    ),
+    info!(
+        "tangentWeight",
+        "tangent-weight",
+        SUBDIV,
+        &[],
+        "CG: tangential error weight"
+    ),
+    info!(
+        "refineGrowth",
+        "refine-growth",
+        SUBDIV,
+        &[],
+        "largest growth of one refinement"
+    ),
+    info!(
+        "remesh",
+        "no-remesh",
+        SUBDIV,
+        &[],
+        "edge flips after a refinement (Loop)"
+    ),
     info!("cloud", "cloud", SUBDIV, &[], "how bare points are meshed"),
-    info!("outliers", "outliers", SUBDIV, &[], "outlier removal, standard deviations"),
-    info!("useGrid", "no-grid", SUBDIV, &[], "mesh a range scan along its grid"),
+    info!(
+        "outliers",
+        "outliers",
+        SUBDIV,
+        &[],
+        "outlier removal, standard deviations"
+    ),
+    info!(
+        "useGrid",
+        "no-grid",
+        SUBDIV,
+        &[],
+        "mesh a range scan along its grid"
+    ),
     info!("closed", "closed", CURVES, &[], "fit a closed curve"),
     info!("degree", "degree", &[BS, BC], &[], "degree"),
     info!("tolMode", "tol-mode", &[BS], &[], "how patches are judged"),
     info!("beta2", "beta2", &[BS], &[LSQ], "thin-plate weight β2"),
-    info!("beta3", "beta3", &[BS], &[LSQ], "curvature-variation weight β3"),
+    info!(
+        "beta3",
+        "beta3",
+        &[BS],
+        &[LSQ],
+        "curvature-variation weight β3"
+    ),
     info!("solves", "solves", &[BS], &[LSQ], "solves per knot vector"),
-    info!("view", "view", &[BS], &[], "view direction of the projection"),
+    info!(
+        "view",
+        "view",
+        &[BS],
+        &[],
+        "view direction of the projection"
+    ),
     info!("folded", "folded", &[BS], &[], "points on a fold-over"),
-    info!("cornerAngle", "corner-angle", CURVES, &[KNOTS], "angle that makes a corner, degrees"),
-    info!("curvatureJump", "curvature-jump", CURVES, &[KNOTS], "jump that makes a double knot"),
+    info!(
+        "cornerAngle",
+        "corner-angle",
+        CURVES,
+        &[KNOTS],
+        "angle that makes a corner, degrees"
+    ),
+    info!(
+        "curvatureJump",
+        "curvature-jump",
+        CURVES,
+        &[KNOTS],
+        "jump that makes a double knot"
+    ),
 ];
 
 impl Default for FitSpec {
@@ -439,7 +542,8 @@ impl FitSpec {
             }
             Scheme::BsplineCurve | Scheme::ChaikinCurve => {
                 let k = KnotPlacementOptions::DEFAULT;
-                d.degree = (scheme == Scheme::BsplineCurve).then_some(CurveFitOptions::DEFAULT.degree);
+                d.degree =
+                    (scheme == Scheme::BsplineCurve).then_some(CurveFitOptions::DEFAULT.degree);
                 d.corner_angle = Some(k.corner_angle_deg);
                 d.curvature_jump = Some(k.curvature_jump);
             }
@@ -500,16 +604,6 @@ impl FitSpec {
     /// [`FitSpec::build`].
     pub fn validate(&self) -> Result<(), FitError> {
         let (scheme, method) = (self.scheme, self.method());
-        if !scheme.methods().contains(&method) {
-            let names: Vec<String> = scheme.methods().iter().map(|m| format!("'{m}'")).collect();
-            return Err(FitError::InvalidOption {
-                name: "method",
-                reason: format!(
-                    "'{method}' is not one of {} (scheme {scheme})",
-                    names.join(", ")
-                ),
-            });
-        }
         for name in self.given() {
             let info = OPTION_TABLE.iter().find(|o| o.name == name);
             if info.is_some_and(|o| !o.applies(scheme, method)) {
@@ -522,6 +616,16 @@ impl FitSpec {
                     method: by_method.then_some(method),
                 });
             }
+        }
+        if !scheme.methods().contains(&method) {
+            let names: Vec<String> = scheme.methods().iter().map(|m| format!("'{m}'")).collect();
+            return Err(FitError::InvalidOption {
+                name: "method",
+                reason: format!(
+                    "'{method}' is not one of {} (scheme {scheme})",
+                    names.join(", ")
+                ),
+            });
         }
         self.check_ranges()
     }
@@ -536,9 +640,15 @@ impl FitSpec {
             return bad("maxIter", "must be at least 1".into());
         }
         if let Some(r) = self.outliers.filter(|r| !(r.is_finite() && *r > 0.0)) {
-            return bad("outliers", format!("{r} is not a positive number of deviations"));
+            return bad(
+                "outliers",
+                format!("{r} is not a positive number of deviations"),
+            );
         }
-        if let Some(v) = self.view.filter(|v| !Vec3::from(*v).is_finite() || Vec3::from(*v).length() == 0.0) {
+        if let Some(v) = self
+            .view
+            .filter(|v| !Vec3::from(*v).is_finite() || Vec3::from(*v).length() == 0.0)
+        {
             return bad("view", format!("{v:?} is not a direction"));
         }
         match self.scheme {
@@ -577,10 +687,9 @@ impl FitSpec {
                     self.subdiv_options(),
                 )?)
             }
-            (Scheme::BsplineSurface, Method::Geometric) => Box::new(GeometricSurfaceFitter::try_new(
-                points,
-                self.geometric_surface_options(),
-            )?),
+            (Scheme::BsplineSurface, Method::Geometric) => Box::new(
+                GeometricSurfaceFitter::try_new(points, self.geometric_surface_options())?,
+            ),
             (Scheme::BsplineSurface, _) => {
                 Box::new(LsqSurfaceFitter::try_new(points, self.lsq_options())?)
             }
@@ -800,7 +909,10 @@ mod tests {
         }
         assert_eq!("bspline".parse::<Scheme>(), Ok(Scheme::BsplineSurface));
         let err = "nurbs".parse::<Scheme>().unwrap_err();
-        assert!(err.starts_with("option scheme: 'nurbs' is not one of 'loop'"), "{err}");
+        assert!(
+            err.starts_with("option scheme: 'nurbs' is not one of 'loop'"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -815,14 +927,22 @@ mod tests {
         assert_eq!(loop_.initial, None);
         let surface = FitSpec::defaults(Scheme::BsplineSurface);
         assert_eq!(surface.method, Some(Method::LeastSquares));
-        assert_eq!(surface.max_iter, Some(LsqSurfaceOptions::DEFAULT.max_iterations));
+        assert_eq!(
+            surface.max_iter,
+            Some(LsqSurfaceOptions::DEFAULT.max_iterations)
+        );
         assert_eq!(surface.tol_avg, None);
     }
 
     #[test]
     fn options_of_other_schemes_are_rejected() {
-        let err = FitSpec::new(Scheme::BsplineSurface).with_tol_avg(Some(0.1)).validate();
-        assert!(matches!(err, Err(FitError::NotApplicable { name: "tolAvg", .. })));
+        let err = FitSpec::new(Scheme::BsplineSurface)
+            .with_tol_avg(Some(0.1))
+            .validate();
+        assert!(matches!(
+            err,
+            Err(FitError::NotApplicable { name: "tolAvg", .. })
+        ));
         let mut spec = FitSpec::new(Scheme::BsplineSurface);
         spec.beta2 = Some(1e-9);
         spec.method = Some(Method::Geometric);
@@ -831,8 +951,13 @@ mod tests {
             err,
             "option beta2 does not apply to scheme bspline-surface with method geometric"
         );
-        let err = FitSpec::new(Scheme::Loop).with_method(Some(Method::LeastSquares)).validate();
-        assert!(matches!(err, Err(FitError::NotApplicable { name: "method", .. })));
+        let err = FitSpec::new(Scheme::Loop)
+            .with_method(Some(Method::LeastSquares))
+            .validate();
+        assert!(matches!(
+            err,
+            Err(FitError::NotApplicable { name: "method", .. })
+        ));
     }
 
     #[test]
@@ -843,8 +968,15 @@ mod tests {
         assert_eq!(spec.scheme, Scheme::BsplineSurface);
         assert_eq!(spec.surface_grid().control, (10, 12));
         let err = serde_json::from_str::<FitSpec>(r#"{"tolerance":1}"#).unwrap_err();
-        assert!(err.to_string().contains("unknown field `tolerance`"), "{err}");
+        assert!(
+            err.to_string().contains("unknown field `tolerance`"),
+            "{err}"
+        );
         let err = serde_json::from_str::<FitSpec>(r#"{"cloud":"sideways"}"#).unwrap_err();
-        assert!(err.to_string().contains("option cloud: 'sideways' is not one of"), "{err}");
+        assert!(
+            err.to_string()
+                .contains("option cloud: 'sideways' is not one of"),
+            "{err}"
+        );
     }
 }

@@ -94,7 +94,6 @@ impl LoadedFile {
             dimension: 3,
         }
     }
-
 }
 
 /// Reads a file from bytes. The format is taken from the content, with `name` (a file name

@@ -268,7 +268,6 @@ impl BSplineCurve {
         c
     }
 
-
     /// The foot point of `p`, seeded from the best of `samples_per_span` samples in every knot
     /// span; use it when no good starting parameter is known.
     pub fn closest_point(&self, p: Point3, samples_per_span: usize) -> Nearest<f64> {
@@ -584,8 +583,8 @@ impl ClosestPoint for BSplineCurve {
                 return self.nearest(u, &c, dist_sq, it, true);
             }
             let speed = g.sqrt();
-            let tol = opts.step_tol * (b - a)
-                + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
+            let tol =
+                opts.step_tol * (b - a) + 1e-9 * dist_sq.sqrt() / speed.max(f64::MIN_POSITIVE);
             let mut du = (-f / denom).clamp(-0.25 * (b - a), 0.25 * (b - a));
             if du.abs() <= tol {
                 return self.nearest(u, &c, dist_sq, it, true);

@@ -304,7 +304,6 @@ impl BSplineSurface {
         }
         Ok(())
     }
-
 }
 
 /// Candidate steps (Δu, Δv) for min ½|S − p|²: the Newton step where the Hessian is positive
@@ -452,8 +451,7 @@ impl ClosestPoint for BSplineSurface {
             }
             // A step under the tolerance is the remaining parameter error (Newton converges
             // quadratically): stop here without evaluating the surface once more.
-            let tiny_step =
-                |st: &(f64, f64)| st.0.abs().max(st.1.abs()) <= opts.step_tol * scale;
+            let tiny_step = |st: &(f64, f64)| st.0.abs().max(st.1.abs()) <= opts.step_tol * scale;
             if steps.iter().flatten().next().is_some_and(tiny_step) {
                 converged = true;
                 break;

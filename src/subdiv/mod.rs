@@ -21,6 +21,7 @@ mod tessellate;
 mod topo;
 mod walk;
 
+pub use nearest::newton_foot;
 pub use refine::{limit_positions, quadrangulate, refine, refine_levels};
 pub use surface::SubdivSurface;
 pub use tessellate::{tessellate, Tessellation};

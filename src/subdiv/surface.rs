@@ -2,8 +2,8 @@
 //! topological precomputed so evaluation after moving control points is only weighted sums.
 
 use super::doo_sabin::limits_of;
-use super::sites::DooSabinSites;
 use super::patch::{neighbourhood, vertex_neighbourhood, Graph, Kind};
+use super::sites::DooSabinSites;
 use super::topo::{Stencil, Topo};
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
 use crate::geom::{Point3, Vec3};
@@ -51,7 +51,6 @@ fn primal_sites(mesh: &ControlMesh) -> Vec<(u32, u32)> {
         .map(|f| (f, mesh.face_vertices(f).next().unwrap_or(0)))
         .collect()
 }
-
 
 impl SubdivSurface {
     /// The limit surface of `mesh` under `scheme` (Loop needs triangles, Catmull–Clark quads).

@@ -53,7 +53,8 @@ pub fn tessellate<S: LimitSurface + ?Sized>(surface: &S, segments: usize) -> Tes
                     for j in 0..r - i {
                         t.triangles.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
                         if j + 1 < r - i {
-                            t.triangles.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+                            t.triangles
+                                .push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
                         }
                     }
                 }

@@ -5,7 +5,9 @@
 
 use super::scan::LoadedScan;
 use crate::export;
-use crate::fit::{FitReport, FitSpec, FitStatus, Fitter as CoreFitter, IterationRecord, Method, Scheme, Shape};
+use crate::fit::{
+    FitReport, FitSpec, FitStatus, Fitter as CoreFitter, IterationRecord, Method, Scheme, Shape,
+};
 use crate::geom::Point3;
 use crate::io;
 use crate::mesh::PolyMesh;
@@ -57,11 +59,26 @@ pub fn options_for(scheme: &str, method: Option<String>) -> Result<Vec<String>, 
         .collect())
 }
 
+/// The exports a fit of `scheme` offers: `cage`, `json` always; `obj`, `ply`, `stl` for
+/// surfaces; `iges`, `step` for B-splines. Throws on an unknown scheme name.
+#[wasm_bindgen(js_name = exportsFor)]
+pub fn exports_for(scheme: &str) -> Result<Vec<String>, JsError> {
+    let scheme: Scheme = scheme.parse().map_err(|e: String| JsError::new(&e))?;
+    Ok(export::exports_for(scheme)
+        .iter()
+        .map(|e| e.to_string())
+        .collect())
+}
+
 /// The methods of `scheme`, its default first.
 #[wasm_bindgen(js_name = methodsFor)]
 pub fn methods_for(scheme: &str) -> Result<Vec<String>, JsError> {
     let scheme: Scheme = scheme.parse().map_err(|e: String| JsError::new(&e))?;
-    Ok(scheme.methods().iter().map(|m: &Method| m.name().to_string()).collect())
+    Ok(scheme
+        .methods()
+        .iter()
+        .map(|m: &Method| m.name().to_string())
+        .collect())
 }
 
 /// One iteration's figures as JavaScript sees them (camelCase plain object).
@@ -83,6 +100,9 @@ struct JsStats {
     refined: bool,
     scheme: &'static str,
     method: &'static str,
+    tol_avg_pct: Option<f64>,
+    tol_max_pct: Option<f64>,
+    tol_rms_pct: Option<f64>,
 }
 
 /// One history entry (camelCase plain object).
@@ -232,8 +252,9 @@ impl Fitter {
     }
 
     /// `{iter, controlPoints, eAvgPct, eMaxPct, eRmsPct, eAvg, eMax, eRms, diagonal, ms,
-    /// totalMs, status, refined, scheme, method}`: the current errors (in % of the diagonal
-    /// and model units), the last iteration's time and flags; status is 'running',
+    /// totalMs, status, refined, scheme, method, tolAvgPct, tolMaxPct, tolRmsPct}`: the
+    /// current errors (in % of the diagonal and model units), the last iteration's time and
+    /// flags, and the tolerances in force (`null` where none); status is 'running',
     /// 'converged' or 'max_iterations'.
     pub fn stats(&self) -> Result<JsValue, JsError> {
         let f = self.fit.as_ref();
@@ -255,6 +276,9 @@ impl Fitter {
             refined: last.is_some_and(|r| r.refined),
             scheme: f.scheme().name(),
             method: f.method().name(),
+            tol_avg_pct: f.tolerances().avg_pct,
+            tol_max_pct: f.tolerances().max_pct,
+            tol_rms_pct: f.tolerances().rms_pct,
         };
         to_js(&stats)
     }
@@ -363,7 +387,9 @@ impl Fitter {
     /// The fit report (set-up, final errors, times, per-iteration history) as JSON text.
     #[wasm_bindgen(js_name = reportJson)]
     pub fn report_json(&self) -> Result<String, JsError> {
-        Ok(serde_json::to_string_pretty(&FitReport::of(self.fit.as_ref()))?)
+        Ok(serde_json::to_string_pretty(&FitReport::of(
+            self.fit.as_ref(),
+        ))?)
     }
 }
 

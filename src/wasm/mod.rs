@@ -6,7 +6,7 @@ mod fitter;
 mod scan;
 mod viewer;
 
-pub use fitter::{default_spec, methods_for, options_for, Fitter, MeshArrays};
+pub use fitter::{default_spec, exports_for, methods_for, options_for, Fitter, MeshArrays};
 pub use scan::{load_file, LoadedScan};
 pub use viewer::Viewer;
 

@@ -2,11 +2,11 @@
 //! with S(u, v) = (1 − u − v) P0 + u P1 + v P2; walking across an edge uses the lattice
 //! unfolding that the Loop patches use, so the fitter's patch walking is exercised for real.
 
-use geofit::fit::refine::{split_triangles, SplitRule};
 use geofit::fit::{ControlSurface, FitError};
-use geofit::geom::Point3;
+use geofit::geom::{ClosestPoint, Nearest, NewtonOptions, Point3};
 use geofit::mesh::PolyMesh;
-use geofit::subdiv::{LimitEval, LimitSurface, PatchDomain, SurfaceParam};
+use geofit::subdiv::adaptive::{split_triangles, SplitRule};
+use geofit::subdiv::{newton_foot, LimitEval, LimitSurface, PatchDomain, Scheme, SurfaceParam};
 use std::collections::HashMap;
 
 /// The piecewise-linear surface of a triangle mesh.
@@ -87,9 +87,23 @@ impl LimitSurface for Linear {
     }
 }
 
+/// Newton on the piecewise-linear surface, as on any limit surface.
+impl ClosestPoint for Linear {
+    type Param = SurfaceParam;
+    fn closest_point_from(
+        &self,
+        p: Point3,
+        start: SurfaceParam,
+        options: &NewtonOptions,
+    ) -> Nearest<SurfaceParam> {
+        newton_foot(self, p, start, options)
+    }
+}
+
+/// Reported as Loop: like Loop's, its patches are the control triangles.
 impl ControlSurface for Linear {
-    fn scheme_name(&self) -> &'static str {
-        "linear"
+    fn scheme(&self) -> Scheme {
+        Scheme::Loop
     }
     fn control_polygons(&self) -> PolyMesh {
         PolyMesh::try_new(self.points.clone(), &self.tris).expect("valid by construction")
@@ -101,14 +115,14 @@ impl ControlSurface for Linear {
         patch as usize
     }
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
-        split_triangles(control, marked, SplitRule::Midpoint)
+        Ok(split_triangles(control, marked, SplitRule::Midpoint)?)
     }
 }
 
 impl Linear {
     /// The surface of a triangle mesh.
     pub fn try_new(control: &PolyMesh) -> Result<Self, FitError> {
-        let tris = geofit::fit::refine::triangles_of(control)?;
+        let tris = geofit::subdiv::adaptive::triangles_of(control)?;
         let mut owner: HashMap<(u32, u32), (u32, usize)> = HashMap::new();
         for (f, t) in tris.iter().enumerate() {
             for k in 0..3 {

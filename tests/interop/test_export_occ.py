@@ -2,7 +2,7 @@
 """Interoperability of geofit's IGES and STEP export with Open CASCADE (cadquery-ocp).
 
 Runs `geofit export-samples` (open, closed and rational curves, B-spline and NURBS surfaces)
-and `geofit fit-curve` on the bunny section (both methods), reads every exported file back with
+and `geofit fit --scheme bspline-curve` on the bunny section (both methods), reads every exported file back with
 OCC's IGES and STEP readers, and checks that OCC evaluates the geometry at geofit's sample
 parameters to within 1e-9 of the bounding-box diagonal.
 
@@ -131,7 +131,7 @@ def main():
         section = REPO / "tests" / "data" / "bunny_section.xyz"
         for method in ("geometric", "knots"):
             stem = out / f"bunny_{method}"
-            subprocess.run([exe, "fit-curve", str(section), "--closed", "--method", method,
+            subprocess.run([exe, "fit", str(section), "--scheme", "bspline-curve", "--quiet", "--closed", "--method", method,
                             "--tol-max", "0.01", "--json", f"{stem}.json",
                             "--iges", f"{stem}.igs", "--step", f"{stem}.stp"], check=True)
             report = json.loads(Path(f"{stem}.json").read_text())

@@ -5,11 +5,11 @@
 
 use crate::output::read_input;
 use geofit::export::{self, EXPORT_RESOLUTION};
-use geofit::fit::{
-    Cloud, FitData, FitError, FitReport, FitSpec, FitStatus, Fitter, Method, Scheme, Shape,
-    Spline, Weighting, OPTION_TABLE,
-};
 use geofit::fit::{Acceleration, FoldPolicy, TolMode};
+use geofit::fit::{
+    Cloud, FitData, FitError, FitReport, FitSpec, FitStatus, Fitter, Method, Scheme, Shape, Spline,
+    Weighting, OPTION_TABLE,
+};
 use geofit::geom::Vec3;
 use geofit::spline::BSplineSurface;
 use serde::Serialize;
@@ -264,7 +264,11 @@ impl Args {
                 self.surface_json.is_some(),
                 s == Scheme::BsplineSurface,
             ),
-            ("--control", self.control.is_some(), s.subdivision().is_some()),
+            (
+                "--control",
+                self.control.is_some(),
+                s.subdivision().is_some(),
+            ),
             (
                 "--ctrl",
                 self.ctrl.is_some() || self.ctrl_u.is_some(),
@@ -399,7 +403,8 @@ fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
         .and_then(|s| s.to_str())
         .unwrap_or("geofit");
     if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&FitReport::of(fitter)).map_err(|e| e.to_string())?;
+        let text =
+            serde_json::to_string_pretty(&FitReport::of(fitter)).map_err(|e| e.to_string())?;
         write(path, text.as_bytes())?;
     }
     if let Some(path) = &args.cage {
@@ -407,18 +412,32 @@ fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
     }
     if let (Some(path), Shape::Mesh(mesh)) = (&args.limit, fitter.limit_shape(args.limit_segments))
     {
-        write(path, &geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string())?)?;
+        write(
+            path,
+            &geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string())?,
+        )?;
     }
     if let Some(path) = &args.iges {
-        write(path, export::iges_of(fitter, name).map_err(|e| e.to_string())?.as_bytes())?;
+        write(
+            path,
+            export::iges_of(fitter, name)
+                .map_err(|e| e.to_string())?
+                .as_bytes(),
+        )?;
     }
     if let Some(path) = &args.step {
-        write(path, export::step_of(fitter, name).map_err(|e| e.to_string())?.as_bytes())?;
+        write(
+            path,
+            export::step_of(fitter, name)
+                .map_err(|e| e.to_string())?
+                .as_bytes(),
+        )?;
     }
     if let (Some(path), Some(Spline::Surface { surface, params })) =
         (&args.surface_json, fitter.spline())
     {
-        let json = serde_json::to_string(&surface_json(surface, params)).map_err(|e| e.to_string())?;
+        let json =
+            serde_json::to_string(&surface_json(surface, params)).map_err(|e| e.to_string())?;
         write(path, json.as_bytes())?;
     }
     Ok(())

@@ -3,11 +3,10 @@
 //! points of the foot point's span by basis value and normalised per control point, with
 //! acceleration, damping and knot insertion where the error stays above tolerance.
 //!
-use super::{check_degree, control_polygon, curve_shape, details, scheme_of, CurveData};
+use super::{check_degree, curve_state, details, CurveData};
 use crate::fit::accel::Accelerator;
 use crate::fit::{
-    Acceleration, ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline,
-    Tolerances,
+    Acceleration, FitError, FitState, FitStatus, Fitter, Method, Shape, Spline, Tolerances,
 };
 use crate::geom::{Point3, Vec3};
 use crate::spline::BSplineCurve;
@@ -217,9 +216,7 @@ pub struct CurveFitter {
     options: CurveFitOptions,
     curve: BSplineCurve,
     params: Vec<f64>,
-    errors: Vec<f64>,
-    stats: ErrorStats,
-    log: FitLog,
+    state: FitState,
     accel: Accelerator,
     since_refine: usize,
 }
@@ -243,20 +240,20 @@ impl CurveFitter {
             .map(|&c| curve.normalize_param(c))
             .collect();
         let errors = data.foot_points(&curve, &mut params, options.newton_iter);
-        let stats = ErrorStats::from_distances(&errors, data.diagonal);
+        let n = curve.control_points().len();
+        let mut state = curve_state(&data, p, Method::Geometric, options.tolerances, n, start);
+        state.set_errors(errors);
         let mut fitter = CurveFitter {
             accel: Accelerator::new(options.acceleration),
-            log: FitLog::new(curve.control_points().len(), start),
+            state,
             data,
             options,
             curve,
             params,
-            errors,
-            stats,
             since_refine: 0,
         };
-        if fitter.options.tolerances.met_by(&fitter.stats) {
-            fitter.log.stop(FitStatus::Converged);
+        if fitter.state.met() {
+            fitter.state.log_mut().stop(FitStatus::Converged);
         }
         Ok(fitter)
     }
@@ -297,10 +294,10 @@ impl CurveFitter {
     fn apply(&mut self, ctrl: &[Point3], params: &[f64]) {
         self.curve.control_points_mut().copy_from_slice(ctrl);
         self.params.copy_from_slice(params);
-        self.errors =
-            self.data
-                .foot_points(&self.curve, &mut self.params, self.options.newton_iter);
-        self.stats = ErrorStats::from_distances(&self.errors, self.data.diagonal);
+        let errors = self
+            .data
+            .foot_points(&self.curve, &mut self.params, self.options.newton_iter);
+        self.state.set_errors(errors);
     }
 
     /// One move of the control points, accelerated, undone and taken plain when it raised
@@ -308,11 +305,11 @@ impl CurveFitter {
     fn iterate(&mut self) {
         let x = self.curve.control_points().to_vec();
         let params = self.params.clone();
-        let before = self.stats.e_rms;
+        let before = self.state.stats().e_rms;
         let d = self.moves();
         let proposal = self.accel.propose(&x, &d);
         self.apply(&proposal, &params);
-        if self.stats.e_rms > before && self.options.acceleration != Acceleration::None {
+        if self.state.stats().e_rms > before && self.options.acceleration != Acceleration::None {
             self.accel.reset();
             let plain: Vec<Point3> = x.iter().zip(&d).map(|(p, v)| *p + *v).collect();
             self.apply(&plain, &params);
@@ -336,7 +333,7 @@ impl CurveFitter {
         let knots = self.curve.knots().knots().to_vec();
         // Per span: (span, largest error, its foot parameter).
         let mut per_span: Vec<Option<(f64, f64)>> = vec![None; knots.len()];
-        for (&u, &e) in self.params.iter().zip(&self.errors) {
+        for (&u, &e) in self.params.iter().zip(self.state.errors()) {
             let span = self.curve.knots().find_span(u);
             if per_span[span].is_none_or(|(w, _)| e.abs() > w) {
                 per_span[span] = Some((e.abs(), u));
@@ -378,15 +375,15 @@ impl CurveFitter {
 
 impl Fitter for CurveFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.log.status() != FitStatus::Running {
-            return Ok(self.log.status());
+        if self.status() != FitStatus::Running {
+            return Ok(self.status());
         }
         let start = Instant::now();
-        let before = self.stats.e_max;
+        let before = self.state.stats().e_max;
         self.iterate();
         self.since_refine += 1;
-        let met = self.options.tolerances.met_by(&self.stats);
-        let stalled = self.stats.e_max > before * (1.0 - self.options.stall_ratio);
+        let met = self.state.met();
+        let stalled = self.state.stats().e_max > before * (1.0 - self.options.stall_ratio);
         let due = self.since_refine >= self.options.refine_interval
             || (stalled && self.since_refine >= 2);
         let refined = !met && due && self.refine()?;
@@ -395,73 +392,16 @@ impl Fitter for CurveFitter {
         }
         let status = if met {
             FitStatus::Converged
-        } else if self.log.iterations() + 1 >= self.options.max_iter {
+        } else if self.log().iterations() + 1 >= self.options.max_iter {
             FitStatus::MaxIterations
         } else {
             FitStatus::Running
         };
         let n = self.curve.control_points().len();
-        Ok(self.log.record(start, n, &self.stats, refined, status))
+        Ok(self.state.record(start, n, refined, status))
     }
 
-    fn scheme(&self) -> Scheme {
-        scheme_of(&self.curve)
-    }
-
-    fn method(&self) -> Method {
-        Method::Geometric
-    }
-
-    fn log(&self) -> &FitLog {
-        &self.log
-    }
-
-    fn log_mut(&mut self) -> &mut FitLog {
-        &mut self.log
-    }
-
-    fn tolerances(&self) -> Tolerances {
-        self.options.tolerances
-    }
-
-    fn data(&self) -> &[Point3] {
-        &self.data.points
-    }
-
-    fn diagonal(&self) -> f64 {
-        self.data.diagonal
-    }
-
-    fn point_errors(&self) -> &[f64] {
-        &self.errors
-    }
-
-    fn stats(&self) -> ErrorStats {
-        self.stats
-    }
-
-    fn foot_points(&self) -> Vec<Point3> {
-        self.params.iter().map(|&u| self.curve.eval(u)).collect()
-    }
-
-    fn num_control_points(&self) -> usize {
-        self.curve.control_points().len()
-    }
-
-    fn control_shape(&self) -> Shape {
-        control_polygon(&self.curve)
-    }
-
-    fn limit_shape(&self, resolution: usize) -> Shape {
-        curve_shape(&self.curve, resolution)
-    }
-
-    fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Curve {
-            curve: &self.curve,
-            params: &self.params,
-        })
-    }
+    curve_fitter_methods!(params);
 
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {
         details(&self.curve)

@@ -14,12 +14,8 @@
 //!
 //! Each [`Fitter::step`] is one insertion and one solve.
 
-use super::{
-    check_degree, control_polygon, curve_shape, details, least_squares_curve, scheme_of, CurveData,
-};
-use crate::fit::{
-    ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline, Tolerances,
-};
+use super::{check_degree, curve_state, details, least_squares_curve, CurveData};
+use crate::fit::{FitError, FitState, FitStatus, Fitter, Method, Shape, Spline, Tolerances};
 use crate::geom::{Point3, Vec3};
 use crate::spline::BSplineCurve;
 use web_time::Instant;
@@ -242,9 +238,7 @@ pub struct KnotPlacementFitter {
     params: Vec<f64>,
     /// Foot-point parameters on the current curve (the warm start of the next measurement).
     feet: Vec<f64>,
-    errors: Vec<f64>,
-    stats: ErrorStats,
-    log: FitLog,
+    state: FitState,
 }
 
 impl KnotPlacementFitter {
@@ -272,8 +266,16 @@ impl KnotPlacementFitter {
         let params = data.chord.clone();
         let template = template_curve(&knots, p, options.closed, &data.points)?;
         let curve = least_squares_curve(&template, &data.points, &params)?;
+        let n = curve.control_points().len();
         let mut fitter = KnotPlacementFitter {
-            log: FitLog::new(curve.control_points().len(), start),
+            state: curve_state(
+                &data,
+                p,
+                Method::KnotPlacement,
+                options.tolerances,
+                n,
+                start,
+            ),
             data,
             options,
             features,
@@ -281,12 +283,10 @@ impl KnotPlacementFitter {
             curve,
             params,
             feet: Vec::new(),
-            errors: Vec::new(),
-            stats: ErrorStats::default(),
         };
         fitter.measure();
         if fitter.met() {
-            fitter.log.stop(FitStatus::Converged);
+            fitter.state.log_mut().stop(FitStatus::Converged);
         }
         Ok(fitter)
     }
@@ -308,15 +308,15 @@ impl KnotPlacementFitter {
 
     /// Standard deviation of the signed normal deviations, % of the bbox diagonal.
     pub fn std_pct(&self) -> f64 {
-        let n = self.errors.len().max(1) as f64;
-        let mean = self.errors.iter().sum::<f64>() / n;
-        let var = self.errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / n;
-        var.sqrt() / self.data.diagonal * 100.0
+        let errors = self.state.errors();
+        let n = errors.len().max(1) as f64;
+        let mean = errors.iter().sum::<f64>() / n;
+        let var = errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / n;
+        var.sqrt() / self.state.diagonal() * 100.0
     }
 
     fn met(&self) -> bool {
-        self.options.tolerances.met_by(&self.stats)
-            && self.options.std_pct.is_none_or(|s| self.std_pct() <= s)
+        self.state.met() && self.options.std_pct.is_none_or(|s| self.std_pct() <= s)
     }
 
     /// Foot points (normal deviations) of the data on the current curve, Newton started from
@@ -326,21 +326,22 @@ impl KnotPlacementFitter {
         if self.feet.len() != self.params.len() {
             self.feet = self.params.clone();
         }
-        self.errors = self
+        let errors = self
             .data
             .foot_points(&self.curve, &mut self.feet, self.options.newton_iter);
         if self.options.parameter_correction {
             self.params.clone_from(&self.feet);
         }
-        self.stats = ErrorStats::from_distances(&self.errors, self.data.diagonal);
+        self.state.set_errors(errors);
     }
 
     /// Inserts the knots of one step: at the largest admissible deviation (per the spacing
     /// rules) and, with [`KnotPlacementOptions::batch`], at the largest admissible deviation
     /// above the E_max tolerance of every other knot span. Returns how many were inserted.
     fn insert_knots(&mut self) -> usize {
-        let mut order: Vec<usize> = (0..self.errors.len()).collect();
-        order.sort_by(|&a, &b| self.errors[b].abs().total_cmp(&self.errors[a].abs()));
+        let errors = self.state.errors();
+        let mut order: Vec<usize> = (0..errors.len()).collect();
+        order.sort_by(|&a, &b| errors[b].abs().total_cmp(&errors[a].abs()));
         let mut sorted: Vec<f64> = self
             .params
             .iter()
@@ -352,7 +353,7 @@ impl KnotPlacementFitter {
         let spans: Vec<f64> = self.knots.iter().map(|k| k.value).collect();
         let mut used: Vec<usize> = Vec::new();
         for i in order {
-            if !used.is_empty() && (!self.options.batch || self.errors[i].abs() <= tol) {
+            if !used.is_empty() && (!self.options.batch || errors[i].abs() <= tol) {
                 break;
             }
             let u = self.curve.normalize_param(self.params[i]);
@@ -459,13 +460,13 @@ fn template_curve(
 
 impl Fitter for KnotPlacementFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.log.status() != FitStatus::Running {
-            return Ok(self.log.status());
+        if self.status() != FitStatus::Running {
+            return Ok(self.status());
         }
         let start = Instant::now();
         let cap = self.options.max_iter.unwrap_or(self.data.points.len());
         if self.insert_knots() == 0 {
-            return Ok(self.log.stop(FitStatus::MaxIterations));
+            return Ok(self.state.log_mut().stop(FitStatus::MaxIterations));
         }
         let template = template_curve(
             &self.knots,
@@ -477,73 +478,16 @@ impl Fitter for KnotPlacementFitter {
         self.measure();
         let status = if self.met() {
             FitStatus::Converged
-        } else if self.log.iterations() + 1 >= cap {
+        } else if self.log().iterations() + 1 >= cap {
             FitStatus::MaxIterations
         } else {
             FitStatus::Running
         };
         let n = self.curve.control_points().len();
-        Ok(self.log.record(start, n, &self.stats, true, status))
+        Ok(self.state.record(start, n, true, status))
     }
 
-    fn scheme(&self) -> Scheme {
-        scheme_of(&self.curve)
-    }
-
-    fn method(&self) -> Method {
-        Method::KnotPlacement
-    }
-
-    fn log(&self) -> &FitLog {
-        &self.log
-    }
-
-    fn log_mut(&mut self) -> &mut FitLog {
-        &mut self.log
-    }
-
-    fn tolerances(&self) -> Tolerances {
-        self.options.tolerances
-    }
-
-    fn data(&self) -> &[Point3] {
-        &self.data.points
-    }
-
-    fn diagonal(&self) -> f64 {
-        self.data.diagonal
-    }
-
-    fn point_errors(&self) -> &[f64] {
-        &self.errors
-    }
-
-    fn stats(&self) -> ErrorStats {
-        self.stats
-    }
-
-    fn foot_points(&self) -> Vec<Point3> {
-        self.feet.iter().map(|&u| self.curve.eval(u)).collect()
-    }
-
-    fn num_control_points(&self) -> usize {
-        self.curve.control_points().len()
-    }
-
-    fn control_shape(&self) -> Shape {
-        control_polygon(&self.curve)
-    }
-
-    fn limit_shape(&self, resolution: usize) -> Shape {
-        curve_shape(&self.curve, resolution)
-    }
-
-    fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Curve {
-            curve: &self.curve,
-            params: &self.feet,
-        })
-    }
+    curve_fitter_methods!(feet);
 
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {
         let mut m = details(&self.curve);

@@ -3,6 +3,43 @@
 //! ([`KnotPlacementFitter`], SPEC §3). Both share the data checks, chord-length parameters,
 //! foot points and drawable shapes here.
 
+/// The [`Fitter`](crate::fit::Fitter) methods besides `step` of a curve fitter with `state`,
+/// `curve` and the foot-point parameters in the field named by the argument.
+macro_rules! curve_fitter_methods {
+    ($feet:ident) => {
+        fn state(&self) -> &FitState {
+            &self.state
+        }
+
+        fn state_mut(&mut self) -> &mut FitState {
+            &mut self.state
+        }
+
+        fn foot_points(&self) -> Vec<Point3> {
+            self.$feet.iter().map(|&u| self.curve.eval(u)).collect()
+        }
+
+        fn num_control_points(&self) -> usize {
+            self.curve.control_points().len()
+        }
+
+        fn control_shape(&self) -> Shape {
+            super::control_polygon(&self.curve)
+        }
+
+        fn limit_shape(&self, resolution: usize) -> Shape {
+            super::curve_shape(&self.curve, resolution)
+        }
+
+        fn spline(&self) -> Option<Spline<'_>> {
+            Some(Spline::Curve {
+                curve: &self.curve,
+                params: &self.$feet,
+            })
+        }
+    };
+}
+
 mod geometric;
 mod knot_placement;
 mod least_squares;
@@ -11,7 +48,7 @@ pub use geometric::{CurveFitOptions, CurveFitter};
 pub use knot_placement::{KnotFeature, KnotPlacementFitter, KnotPlacementOptions};
 pub use least_squares::least_squares_curve;
 
-use super::{FitError, Scheme, Shape};
+use super::{FitError, FitState, Method, Scheme, Shape, Tolerances};
 use crate::geom::{Aabb, ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::spline::{BSplineCurve, MAX_CURVE_DEGREE};
 
@@ -37,12 +74,31 @@ fn check_degree(degree: usize) -> Result<(), FitError> {
 
 /// The scheme a curve of `degree` is fitted as: Chaikin's corner cutting converges to the
 /// quadratic B-spline.
-fn scheme_of(curve: &BSplineCurve) -> Scheme {
-    if curve.degree() == 2 {
+fn scheme_of(degree: usize) -> Scheme {
+    if degree == 2 {
         Scheme::ChaikinCurve
     } else {
         Scheme::BsplineCurve
     }
+}
+
+/// The state of a fit of `data` by `method` with a curve of `degree`, tolerances `tol`, starting
+/// from `initial` control points, set up since `start`.
+fn curve_state(
+    data: &CurveData,
+    degree: usize,
+    method: Method,
+    tol: Tolerances,
+    initial: usize,
+    start: web_time::Instant,
+) -> FitState {
+    FitState::new(
+        (scheme_of(degree), method),
+        tol,
+        data.points.clone(),
+        initial,
+        start,
+    )
 }
 
 /// The control polygon of `curve`.
@@ -75,12 +131,13 @@ fn details(curve: &BSplineCurve) -> serde_json::Map<String, serde_json::Value> {
     m.insert("closed".into(), curve.is_closed().into());
     let (a, b) = curve.domain();
     m.insert("domain".into(), serde_json::json!([a, b]));
-    m.insert(
-        "samples".into(),
-        serde_json::json!(curve.samples(101)),
-    );
+    m.insert("samples".into(), serde_json::json!(curve.samples(101)));
     if let Ok(clamped) = curve.to_clamped() {
-        let points: Vec<[f64; 3]> = clamped.control_points().iter().map(|p| p.to_array()).collect();
+        let points: Vec<[f64; 3]> = clamped
+            .control_points()
+            .iter()
+            .map(|p| p.to_array())
+            .collect();
         m.insert(
             "clamped".into(),
             serde_json::json!({
@@ -187,4 +244,3 @@ impl CurveData {
         }
     }
 }
-

@@ -13,11 +13,8 @@ pub(crate) use setup::build_subdiv_fitter;
 pub use setup::{default_initial_count, initial_control, ReconstructionReport};
 
 use super::accel::Accelerator;
-use super::{
-    Acceleration, ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape,
-    Tolerances,
-};
-use crate::geom::{Aabb, ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
+use super::{Acceleration, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme, Shape};
+use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
 use crate::subdiv::{tessellate, LimitSurface, SurfaceParam};
 use frozen::Stencils;
@@ -73,13 +70,9 @@ pub trait ControlSurface: LimitSurface + ClosestPoint<Param = SurfaceParam> + Si
 /// the first iteration (surface set-up, spatial index, first foot points) is the precompute
 /// phase, timed in its [`FitLog`].
 pub struct SubdivFitter<S: ControlSurface> {
-    data: Vec<Point3>,
-    diagonal: f64,
+    state: FitState,
     surface: S,
     feet: Vec<FootPoint>,
-    signed: Vec<f64>,
-    stats: ErrorStats,
-    log: FitLog,
     options: SubdivFitOptions,
     /// `options.newton` with its step tolerance in model units.
     newton: NewtonOptions,
@@ -102,25 +95,29 @@ impl<S: ControlSurface> SubdivFitter<S> {
         if let Some(index) = data_points.iter().position(|p| !p.is_finite()) {
             return Err(FitError::NonFinitePoint { index });
         }
-        let bbox = Aabb::from_points(data_points).ok_or(FitError::TooFewPoints {
-            found: 0,
-            needed: 1,
-        })?;
+        if data_points.is_empty() {
+            return Err(FitError::TooFewPoints {
+                found: 0,
+                needed: 1,
+            });
+        }
         let control = surface.control_polygons();
         if control.num_faces() == 0 || surface.num_patches() == 0 {
             return Err(FitError::EmptyControlMesh);
         }
         let index = SurfaceIndex::build(&surface, options.index_resolution);
-        let diagonal = bbox.diagonal();
-        let diagonal = if diagonal > 0.0 { diagonal } else { 1.0 };
+        let state = FitState::new(
+            (Scheme::from(surface.scheme()), Method::Geometric),
+            options.tolerances,
+            data_points.to_vec(),
+            control.num_vertices(),
+            start,
+        );
+        let diagonal = state.diagonal();
         let mut fitter = SubdivFitter {
-            data: data_points.to_vec(),
-            diagonal,
-            log: FitLog::new(control.num_vertices(), start),
+            state,
             surface,
             feet: Vec::new(),
-            signed: Vec::new(),
-            stats: ErrorStats::default(),
             newton: options
                 .newton
                 .with_step_tol(options.newton.step_tol * diagonal),
@@ -131,7 +128,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
             scratch: Vec::new(),
         };
         fitter.search_all_feet()?;
-        fitter.log = FitLog::new(fitter.log.initial_control_points(), start);
+        let n = fitter.log().initial_control_points();
+        *fitter.state.log_mut() = FitLog::new(n, start);
         Ok(fitter)
     }
 
@@ -152,7 +150,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
     /// Error vector e_i = p_i − S(t_i) of every data point.
     pub fn error_vectors(&self) -> Vec<Vec3> {
-        self.data
+        self.state
+            .data()
             .iter()
             .zip(&self.feet)
             .map(|(p, f)| *p - f.point)
@@ -175,15 +174,15 @@ impl<S: ControlSurface> SubdivFitter<S> {
     fn budget(&self) -> usize {
         self.options
             .max_control
-            .unwrap_or(self.data.len() / 2)
-            .max(self.log.initial_control_points())
+            .unwrap_or(self.state.data().len() / 2)
+            .max(self.state.log().initial_control_points())
     }
 
     /// Global search: every foot point from the spatial index, then Newton.
     fn search_all_feet(&mut self) -> Result<(), FitError> {
         let opts = self.newton;
-        let mut feet = Vec::with_capacity(self.data.len());
-        for (i, &p) in self.data.iter().enumerate() {
+        let mut feet = Vec::with_capacity(self.state.data().len());
+        for (i, &p) in self.state.data().iter().enumerate() {
             let start = self
                 .index
                 .nearest(p)
@@ -200,8 +199,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// the better of the two results is kept.
     fn update_feet(&mut self, previous: &[FootPoint]) {
         let opts = self.newton;
-        let slack = 1e-3 * self.diagonal;
-        for (i, &p) in self.data.iter().enumerate() {
+        let slack = 1e-3 * self.state.diagonal();
+        for (i, &p) in self.state.data().iter().enumerate() {
             let prev = previous[i];
             let mut foot = self.surface.closest_point_from(p, prev.param, &opts);
             let grew = foot.dist_sq.sqrt() > 2.0 * prev.dist_sq.sqrt() + slack;
@@ -220,14 +219,26 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
     /// Signed distances and statistics from the current foot points.
     fn update_errors(&mut self) {
-        self.signed.clear();
-        for (p, f) in self.data.iter().zip(&self.feet) {
-            let d = f.dist_sq.sqrt();
-            let side = (*p - f.point).dot(f.direction);
-            let s = if side < 0.0 { -d } else { d };
-            self.signed.push(if s.is_finite() { s } else { f64::MAX });
-        }
-        self.stats = ErrorStats::from_distances(&self.signed, self.diagonal);
+        let signed = self
+            .state
+            .data()
+            .iter()
+            .zip(&self.feet)
+            .map(|(p, f)| {
+                let d = f.dist_sq.sqrt();
+                let s = if (*p - f.point).dot(f.direction) < 0.0 {
+                    -d
+                } else {
+                    d
+                };
+                if s.is_finite() {
+                    s
+                } else {
+                    f64::MAX
+                }
+            })
+            .collect();
+        self.state.set_errors(signed);
     }
 
     /// The move of every control point: the normalised weighted sum of the error vectors
@@ -236,7 +247,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let n = self.num_control_points();
         let mut sum = vec![Vec3::ZERO; n];
         let mut weight = vec![0.0; n];
-        for (p, f) in self.data.iter().zip(&self.feet) {
+        for (p, f) in self.state.data().iter().zip(&self.feet) {
             let e = *p - f.point;
             self.scratch.clear();
             match self.options.weighting {
@@ -261,7 +272,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
     fn move_control_points(&mut self) -> bool {
         let old_points = self.surface.control_points().to_vec();
         let old_feet = self.feet.clone();
-        let (old_signed, old_stats) = (self.signed.clone(), self.stats);
+        let (old_signed, old_stats) = (self.state.errors().to_vec(), self.state.stats());
         let d = match self.options.acceleration {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
@@ -278,7 +289,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let proposal = self.accel.propose(&old_points, &d);
         self.surface.set_control_points(&proposal);
         self.update_feet(&old_feet);
-        if !self.options.damping || self.stats.e_rms <= old_stats.e_rms * (1.0 + 1e-12) {
+        if !self.options.damping || self.state.stats().e_rms <= old_stats.e_rms * (1.0 + 1e-12) {
             return true;
         }
         self.accel.reset();
@@ -290,14 +301,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .collect();
             self.surface.set_control_points(&damped);
             self.update_feet(&old_feet);
-            if self.stats.e_rms <= old_stats.e_rms {
+            if self.state.stats().e_rms <= old_stats.e_rms {
                 return true;
             }
         }
         self.surface.set_control_points(&old_points);
         self.feet = old_feet;
-        self.signed = old_signed;
-        self.stats = old_stats;
+        self.state.restore(old_signed, old_stats);
         false
     }
 
@@ -308,7 +318,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let control = self.control_mesh();
         let nf = control.num_faces();
         let (mut max, mut sum, mut sum_sq) = (vec![0.0f64; nf], vec![0.0; nf], vec![0.0; nf]);
-        for (f, d) in self.feet.iter().zip(&self.signed) {
+        for (f, d) in self.feet.iter().zip(self.state.errors()) {
             let face = self.surface.patch_face(f.param.patch);
             if face < nf {
                 max[face] = max[face].max(d.abs());
@@ -317,14 +327,14 @@ impl<S: ControlSurface> SubdivFitter<S> {
             }
         }
         let t = self.options.tolerances;
-        let tmax = t.max_pct.map(|v| v / 100.0 * self.diagonal);
+        let tmax = t.max_pct.map(|v| v / 100.0 * self.state.diagonal());
         let by = |key: &[f64], keep: &dyn Fn(usize) -> bool| {
             let mut faces: Vec<usize> = (0..nf).filter(|&f| keep(f)).collect();
             faces.sort_by(|&a, &b| key[b].total_cmp(&key[a]).then(a.cmp(&b)));
             faces
         };
         let mut order = by(&max, &|f| tmax.is_some_and(|t| max[f] > t));
-        let s = &self.stats;
+        let s = &self.state.stats();
         let avg_missed = t.avg_pct.is_some_and(|v| s.e_avg_pct > v);
         let rms_missed = t.rms_pct.is_some_and(|v| s.e_rms_pct > v);
         if avg_missed || rms_missed {
@@ -355,7 +365,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// most the option (two per point made the bunny fit 6 % slower for the same result: the
     /// index only seeds Newton, which walks across patches from there).
     fn index_resolution(&self) -> usize {
-        let per_patch = self.data.len() as f64 / self.surface.num_patches().max(1) as f64;
+        let per_patch = self.state.data().len() as f64 / self.surface.num_patches().max(1) as f64;
         (per_patch.sqrt().ceil() as usize).clamp(1, self.options.index_resolution)
     }
 
@@ -428,8 +438,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
             }
         }
         let opts = self.newton;
-        for i in 0..self.data.len() {
-            let (p, prev) = (self.data[i], self.feet[i].param);
+        for i in 0..self.feet.len() {
+            let (p, prev) = (self.state.data()[i], self.feet[i].param);
             if let Some(&patch) = copy_of.get(prev.patch as usize).filter(|&&c| c != u32::MAX) {
                 self.feet[i].param.patch = patch;
                 continue;
@@ -466,73 +476,45 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
 impl<S: ControlSurface> Fitter for SubdivFitter<S> {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.log.status() != FitStatus::Running {
-            return Ok(self.log.status());
+        if self.status() != FitStatus::Running {
+            return Ok(self.status());
         }
-        if self.options.tolerances.met_by(&self.stats) {
-            return Ok(self.log.stop(FitStatus::Converged));
+        if self.state.met() {
+            return Ok(self.state.log_mut().stop(FitStatus::Converged));
         }
         let start = Instant::now();
-        let before = self.stats.e_rms;
+        let before = self.state.stats().e_rms;
         let moved = self.move_control_points();
         self.since_refine += 1;
         let improvement = if before > 0.0 && moved {
-            (before - self.stats.e_rms) / before
+            (before - self.state.stats().e_rms) / before
         } else {
             0.0
         };
         let mut refined = false;
-        if !self.options.tolerances.met_by(&self.stats) && self.due_for_refinement(improvement) {
+        if !self.state.met() && self.due_for_refinement(improvement) {
             refined = self.refine()?;
             if refined {
                 self.since_refine = 0;
             }
         }
-        let status = if self.options.tolerances.met_by(&self.stats) {
+        let status = if self.state.met() {
             FitStatus::Converged
-        } else if self.log.iterations() + 1 >= self.options.max_iter {
+        } else if self.log().iterations() + 1 >= self.options.max_iter {
             FitStatus::MaxIterations
         } else {
             FitStatus::Running
         };
         let n = self.num_control_points();
-        Ok(self.log.record(start, n, &self.stats, refined, status))
+        Ok(self.state.record(start, n, refined, status))
     }
 
-    fn scheme(&self) -> Scheme {
-        Scheme::from(self.surface.scheme())
+    fn state(&self) -> &FitState {
+        &self.state
     }
 
-    fn method(&self) -> Method {
-        Method::Geometric
-    }
-
-    fn log(&self) -> &FitLog {
-        &self.log
-    }
-
-    fn log_mut(&mut self) -> &mut FitLog {
-        &mut self.log
-    }
-
-    fn tolerances(&self) -> Tolerances {
-        self.options.tolerances
-    }
-
-    fn data(&self) -> &[Point3] {
-        &self.data
-    }
-
-    fn diagonal(&self) -> f64 {
-        self.diagonal
-    }
-
-    fn point_errors(&self) -> &[f64] {
-        &self.signed
-    }
-
-    fn stats(&self) -> ErrorStats {
-        self.stats
+    fn state_mut(&mut self) -> &mut FitState {
+        &mut self.state
     }
 
     fn foot_points(&self) -> Vec<Point3> {

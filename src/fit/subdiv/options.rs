@@ -107,10 +107,7 @@ impl SubdivFitOptions {
             return bad("refineInterval", "must be at least 1".into());
         }
         if !(self.refine_growth.is_finite() && self.refine_growth > 0.0) {
-            return bad(
-                "refineGrowth",
-                format!("{} is not > 0", self.refine_growth),
-            );
+            return bad("refineGrowth", format!("{} is not > 0", self.refine_growth));
         }
         if !(self.stall_ratio.is_finite() && (0.0..1.0).contains(&self.stall_ratio)) {
             return bad(
@@ -119,7 +116,8 @@ impl SubdivFitOptions {
             );
         }
         self.acceleration.validate()?;
-        if matches!(self.acceleration, Acceleration::Cg { .. }) && self.weighting == Weighting::Patent
+        if matches!(self.acceleration, Acceleration::Cg { .. })
+            && self.weighting == Weighting::Patent
         {
             return bad(
                 "acceleration",

@@ -2,8 +2,8 @@
 //! mesh by QEM simplification, scheme set-up, fitter. [`crate::fit::FitSpec::build`] calls it.
 
 use super::{SubdivFitOptions, SubdivFitter};
-use crate::fit::{FitError, Fitter};
 use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
+use crate::fit::{FitError, Fitter};
 use crate::geom::Point3;
 use crate::io::RangeGrid;
 use crate::mesh::PolyMesh;

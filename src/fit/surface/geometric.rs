@@ -8,17 +8,16 @@
 //! was).
 
 use super::parameterize::{check_points, parameterize, Parameterization};
-use super::patches::{correct_parameters, failing_share, patch_errors, split_worst, PatchGrid};
+use super::patches::{failing_share, split_worst};
 use super::{
-    check_early_split_share, control_grid, details, iso_lines, plane_surface, surface_feet,
-    surface_mesh, LsqSurfaceFitter, LsqSurfaceOptions, SurfaceGrid,
+    check_early_split_share, plane_surface, LsqSurfaceFitter, LsqSurfaceOptions, SurfaceFit,
+    SurfaceGrid,
 };
 use crate::fit::accel::Accelerator;
 use crate::fit::{
-    Acceleration, ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline,
-    Tolerances,
+    Acceleration, FitError, FitLog, FitState, FitStatus, Fitter, Method, Shape, Spline,
 };
-use crate::geom::{Aabb, Point3, Vec3};
+use crate::geom::{Point3, Vec3};
 use crate::spline::BSplineSurface;
 use web_time::Instant;
 
@@ -110,15 +109,8 @@ setters!(GeometricSurfaceOptions {
 
 /// Geometric (error-vector) B-spline surface fitter, driven through [`Fitter`].
 pub struct GeometricSurfaceFitter {
-    points: Vec<Point3>,
-    active: Vec<bool>,
-    uv: Vec<[f64; 2]>,
-    dist: Vec<f64>,
-    num_folded: usize,
-    surface: BSplineSurface,
+    fit: SurfaceFit,
     opts: GeometricSurfaceOptions,
-    diagonal: f64,
-    log: FitLog,
     accel: Accelerator,
     iters_at_knots: usize,
 }
@@ -133,87 +125,45 @@ impl GeometricSurfaceFitter {
         check_points(points, g.degree + 1)?;
         let mut param = parameterize(points, &g.param)?;
         let mut surface = plane_surface(&param, g.degree, g.control)?;
-        let active: Vec<bool> = (0..points.len())
-            .map(|i| param.is_active(i, g.param.fold_policy))
-            .collect();
         if opts.warm_start {
             (surface, param.uv) = least_squares_start(points, param.clone(), surface, &opts)?;
         }
-        let diagonal = Aabb::from_points(points).map_or(0.0, |b| b.diagonal());
         let mut fitter = GeometricSurfaceFitter {
-            points: points.to_vec(),
-            active,
-            dist: vec![0.0; points.len()],
-            num_folded: param.num_folded,
-            uv: param.uv,
-            log: FitLog::new(g.control.0 * g.control.1, start),
-            surface,
+            fit: SurfaceFit::new(Method::Geometric, &g, points, param, surface, start),
             opts,
-            diagonal,
             accel: Accelerator::new(opts.acceleration),
             iters_at_knots: 0,
         };
-        fitter.foot_points();
-        fitter.log = FitLog::new(g.control.0 * g.control.1, start);
+        fitter.fit.correct(opts.newton_iterations);
+        *fitter.fit.state.log_mut() = FitLog::new(g.control.0 * g.control.1, start);
         Ok(fitter)
     }
 
-    /// The current surface.
-    pub fn surface(&self) -> &BSplineSurface {
-        &self.surface
-    }
-
-    /// Points found on a fold-over of the initial projection.
-    pub fn num_folded(&self) -> usize {
-        self.num_folded
-    }
-
-    /// The foot-point parameters (u, v) of every data point, in data order.
-    pub fn parameters(&self) -> &[[f64; 2]] {
-        &self.uv
-    }
-
-    fn foot_points(&mut self) {
-        correct_parameters(
-            &self.surface,
-            &self.points,
-            &mut self.uv,
-            &mut self.dist,
-            self.opts.newton_iterations,
-        );
-    }
+    surface_accessors!();
 
     /// The normalised basis-weighted error vector of every control point (zero where no
     /// point's patch reaches it).
     fn moves(&self) -> Vec<Vec3> {
-        let (nu, nv) = self.surface.num_control();
-        let (p, q) = (
-            self.surface.knots_u().degree(),
-            self.surface.knots_v().degree(),
-        );
+        let s = &self.fit.surface;
+        let (nu, nv) = s.num_control();
+        let (p, q) = (s.knots_u().degree(), s.knots_v().degree());
         let mut num = vec![Vec3::ZERO; nu * nv];
         let mut den = vec![0.0; nu * nv];
-        for ((pt, t), _) in self
-            .points
-            .iter()
-            .zip(&self.uv)
-            .zip(&self.active)
-            .filter(|x| *x.1)
-        {
+        for (pt, t) in self.fit.samples() {
             // One basis evaluation gives both the foot point and the weights.
-            let b = self.surface.basis(t[0], t[1]);
-            let ctrl = self.surface.control_points();
+            let b = s.basis(t[0], t[1]);
+            let ctrl = s.control_points();
             let mut foot = Vec3::ZERO;
             for r in 0..=p {
-                for s in 0..=q {
-                    foot += b.bu[r] * b.bv[s] * ctrl[(b.first_u + r) * nv + b.first_v + s];
+                for k in 0..=q {
+                    foot += b.bu[r] * b.bv[k] * ctrl[(b.first_u + r) * nv + b.first_v + k];
                 }
             }
             let e = *pt - foot;
             for r in 0..=p {
-                for s in 0..=q {
-                    let c = (b.first_u + r) * nv + b.first_v + s;
-                    let w = b.bu[r] * b.bv[s];
+                for k in 0..=q {
+                    let c = (b.first_u + r) * nv + b.first_v + k;
+                    let w = b.bu[r] * b.bv[k];
                     num[c] += e * w;
                     den[c] += w;
                 }
@@ -228,23 +178,22 @@ impl GeometricSurfaceFitter {
     /// Moves the control points (accelerated), keeping the plain step when the accelerated one
     /// raises the RMS error.
     fn move_control_points(&mut self) -> Result<(), FitError> {
-        let rms_before = self.stats().e_rms;
-        let x = self.surface.control_points().to_vec();
+        let before = self.fit.state.stats();
+        let x = self.fit.surface.control_points().to_vec();
         let d = self.moves();
         let proposed = self.accel.propose(&x, &d);
-        let set = |s: &mut BSplineSurface, pts: &[Point3]| {
-            s.set_control_points(pts).map_err(FitError::Spline)
-        };
-        set(&mut self.surface, &proposed)?;
-        let (uv_saved, dist_saved) = (self.uv.clone(), self.dist.clone());
-        self.foot_points();
-        if self.stats().e_rms > rms_before && proposed != plain_step(&x, &d) {
+        self.fit.surface.set_control_points(&proposed)?;
+        let uv_saved = self.fit.uv.clone();
+        let errors_saved = self.fit.state.errors().to_vec();
+        let newton = self.opts.newton_iterations;
+        self.fit.correct(newton);
+        if self.fit.state.stats().e_rms > before.e_rms && proposed != plain_step(&x, &d) {
             // Damping: the accelerated step overshot; take the plain one and forget history.
             self.accel.reset();
-            set(&mut self.surface, &plain_step(&x, &d))?;
-            self.uv = uv_saved;
-            self.dist = dist_saved;
-            self.foot_points();
+            self.fit.surface.set_control_points(&plain_step(&x, &d))?;
+            self.fit.uv = uv_saved;
+            self.fit.state.restore(errors_saved, before);
+            self.fit.correct(newton);
         }
         Ok(())
     }
@@ -274,30 +223,22 @@ fn plain_step(x: &[Point3], d: &[Vec3]) -> Vec<Point3> {
 
 impl Fitter for GeometricSurfaceFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.log.status() != FitStatus::Running {
-            return Ok(self.log.status());
+        if self.status() != FitStatus::Running {
+            return Ok(self.status());
         }
         let start = Instant::now();
-        let rms_before = self.stats().e_rms;
+        let rms_before = self.fit.state.stats().e_rms;
         self.move_control_points()?;
         self.iters_at_knots += 1;
-        let grid = PatchGrid::of(&self.surface);
-        let errors = patch_errors(
-            &self.surface,
-            &grid,
-            &self.uv,
-            &self.dist,
-            &self.active,
-            self.opts.grid.criterion(self.diagonal),
-        );
-        let stalled = self.stats().e_rms > 0.99 * rms_before;
+        let (grid, errors) = self.fit.judge(&self.opts.grid);
+        let stalled = self.fit.state.stats().e_rms > 0.99 * rms_before;
         let split_early = self.iters_at_knots >= self.opts.early_split_after
             && failing_share(&errors) > self.opts.early_split_share;
         let due = stalled || split_early || self.iters_at_knots >= self.opts.iterations_per_knots;
         let mut refined = false;
         let status = if errors.iter().all(|e| e.pass) {
             FitStatus::Converged
-        } else if self.log.iterations() + 1 >= self.opts.max_iterations {
+        } else if self.log().iterations() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
         } else if !due {
             FitStatus::Running
@@ -309,7 +250,7 @@ impl Fitter for GeometricSurfaceFitter {
             }
         } else {
             let inserted = split_worst(
-                &mut self.surface,
+                &mut self.fit.surface,
                 &grid,
                 &errors,
                 self.opts.grid.max_control_points,
@@ -324,75 +265,9 @@ impl Fitter for GeometricSurfaceFitter {
                 FitStatus::MaxIterations
             }
         };
-        let (nu, nv) = self.surface.num_control();
-        let stats = self.stats();
-        Ok(self.log.record(start, nu * nv, &stats, refined, status))
+        let n = self.fit.surface.control_points().len();
+        Ok(self.fit.state.record(start, n, refined, status))
     }
 
-    fn scheme(&self) -> Scheme {
-        Scheme::BsplineSurface
-    }
-
-    fn method(&self) -> Method {
-        Method::Geometric
-    }
-
-    fn log(&self) -> &FitLog {
-        &self.log
-    }
-
-    fn log_mut(&mut self) -> &mut FitLog {
-        &mut self.log
-    }
-
-    fn tolerances(&self) -> Tolerances {
-        Tolerances::max_only(self.opts.grid.tol_pct)
-    }
-
-    fn data(&self) -> &[Point3] {
-        &self.points
-    }
-
-    fn diagonal(&self) -> f64 {
-        self.diagonal
-    }
-
-    fn point_errors(&self) -> &[f64] {
-        &self.dist
-    }
-
-    fn stats(&self) -> ErrorStats {
-        ErrorStats::from_distances(&self.dist, self.diagonal)
-    }
-
-    fn foot_points(&self) -> Vec<Point3> {
-        surface_feet(&self.surface, &self.uv)
-    }
-
-    fn num_control_points(&self) -> usize {
-        self.surface.control_points().len()
-    }
-
-    fn control_shape(&self) -> Shape {
-        control_grid(&self.surface)
-    }
-
-    fn limit_shape(&self, resolution: usize) -> Shape {
-        surface_mesh(&self.surface, resolution)
-    }
-
-    fn iso_lines(&self, resolution: usize) -> Vec<Point3> {
-        iso_lines(&self.surface, resolution)
-    }
-
-    fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Surface {
-            surface: &self.surface,
-            params: &self.uv,
-        })
-    }
-
-    fn details(&self) -> serde_json::Map<String, serde_json::Value> {
-        details(&self.surface, self.num_folded)
-    }
+    surface_fitter_methods!();
 }

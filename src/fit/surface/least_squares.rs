@@ -17,17 +17,10 @@
 
 use super::normal_system::{for_cell_pairs, span_gram, NormalSystem};
 use super::parameterize::{check_points, parameterize, Parameterization};
-use super::patches::{
-    correct_parameters, failing_share, patch_errors, split_worst, PatchError, PatchGrid,
-};
-use super::{
-    check_early_split_share, control_grid, details, iso_lines, plane_surface, surface_feet,
-    surface_mesh, SurfaceGrid,
-};
-use crate::fit::{
-    ErrorStats, FitError, FitLog, FitStatus, Fitter, Method, Scheme, Shape, Spline, Tolerances,
-};
-use crate::geom::{Aabb, Point3};
+use super::patches::{failing_share, split_worst, PatchGrid};
+use super::{check_early_split_share, plane_surface, SurfaceFit, SurfaceGrid};
+use crate::fit::{FitError, FitState, FitStatus, Fitter, Method, Shape, Spline};
+use crate::geom::Point3;
 use crate::spline::BSplineSurface;
 use faer::Mat;
 use web_time::Instant;
@@ -130,15 +123,8 @@ setters!(LsqSurfaceOptions {
 
 /// Smoothed least-squares B-spline surface fitter (SPEC §2), driven through [`Fitter`].
 pub struct LsqSurfaceFitter {
-    points: Vec<Point3>,
-    active: Vec<bool>,
-    uv: Vec<[f64; 2]>,
-    dist: Vec<f64>,
-    num_folded: usize,
-    surface: BSplineSurface,
+    fit: SurfaceFit,
     opts: LsqSurfaceOptions,
-    diagonal: f64,
-    log: FitLog,
     system: Option<NormalSystem>,
     solves_at_knots: usize,
     /// Parameter area of an initial patch over the domain's: the reference of the per-patch
@@ -186,54 +172,34 @@ impl LsqSurfaceFitter {
         opts: LsqSurfaceOptions,
         start: Instant,
     ) -> Result<Self, FitError> {
-        let active: Vec<bool> = (0..points.len())
-            .map(|i| param.is_active(i, opts.grid.param.fold_policy))
-            .collect();
-        let diagonal = Aabb::from_points(points).map_or(0.0, |b| b.diagonal());
-        let (nu, nv) = surface.num_control();
         Ok(LsqSurfaceFitter {
-            points: points.to_vec(),
-            active,
-            dist: vec![0.0; points.len()],
-            num_folded: param.num_folded,
-            uv: param.uv,
-            log: FitLog::new(nu * nv, start),
             ref_cell_area: 1.0 / PatchGrid::of(&surface).len().max(1) as f64,
-            surface,
+            fit: SurfaceFit::new(
+                Method::LeastSquares,
+                &opts.grid,
+                points,
+                param,
+                surface,
+                start,
+            ),
             opts,
-            diagonal,
             system: None,
             solves_at_knots: 0,
         })
     }
 
-    /// The current surface.
-    pub fn surface(&self) -> &BSplineSurface {
-        &self.surface
-    }
-
-    /// Current (u, v) of every point.
-    pub fn parameters(&self) -> &[[f64; 2]] {
-        &self.uv
-    }
-
-    /// Points found on a fold-over of the initial projection.
-    pub fn num_folded(&self) -> usize {
-        self.num_folded
-    }
+    surface_accessors!();
 
     /// The energies (E2, E3) of the current surface over its whole domain, unweighted.
     pub fn energies(&self) -> (f64, f64) {
-        energies(&self.surface)
+        energies(&self.fit.surface)
     }
 
     /// Solves the normal equations for the current knots and parameters.
     fn solve(&mut self) -> Result<(), FitError> {
-        let (nu, nv) = self.surface.num_control();
-        let (p, q) = (
-            self.surface.knots_u().degree(),
-            self.surface.knots_v().degree(),
-        );
+        let surface = &self.fit.surface;
+        let (nu, nv) = surface.num_control();
+        let (p, q) = (surface.knots_u().degree(), surface.knots_v().degree());
         if self
             .system
             .as_ref()
@@ -246,33 +212,27 @@ impl LsqSurfaceFitter {
         };
         system.clear();
         let mut rhs = Mat::<f64>::zeros(nu * nv, 3);
-        let samples = self
-            .points
-            .iter()
-            .zip(&self.uv)
-            .zip(&self.active)
-            .filter(|x| *x.1)
-            .map(|x| x.0);
-        let count = system.add_points(&self.surface, samples, &mut rhs);
-        let grid = PatchGrid::of(&self.surface);
+        let count = system.add_points(surface, self.fit.samples(), &mut rhs);
+        let grid = PatchGrid::of(surface);
         let weights = patch_weights(
-            &self.surface,
+            surface,
             &grid,
-            &self.uv,
-            &self.active,
+            &self.fit.uv,
+            &self.fit.active,
             count,
             self.ref_cell_area,
         );
         let scale = count.max(1) as f64;
         system.add_energies(
-            &self.surface,
+            surface,
             &grid,
             &weights,
             self.opts.beta2 * scale,
             self.opts.beta3 * scale,
         );
         let control = system.solve(rhs)?;
-        self.surface
+        self.fit
+            .surface
             .set_control_points(&control)
             .map_err(|e| FitError::Solver {
                 reason: e.to_string(),
@@ -282,35 +242,20 @@ impl LsqSurfaceFitter {
 
 impl Fitter for LsqSurfaceFitter {
     fn step(&mut self) -> Result<FitStatus, FitError> {
-        if self.log.status() != FitStatus::Running {
-            return Ok(self.log.status());
+        if self.status() != FitStatus::Running {
+            return Ok(self.status());
         }
         let start = Instant::now();
         self.solve()?;
         self.solves_at_knots += 1;
-        correct_parameters(
-            &self.surface,
-            &self.points,
-            &mut self.uv,
-            &mut self.dist,
-            self.opts.newton_iterations,
-        );
-        let grid = PatchGrid::of(&self.surface);
-        let crit = self.opts.grid.criterion(self.diagonal);
-        let errors: Vec<PatchError> = patch_errors(
-            &self.surface,
-            &grid,
-            &self.uv,
-            &self.dist,
-            &self.active,
-            crit,
-        );
+        self.fit.correct(self.opts.newton_iterations);
+        let (grid, errors) = self.fit.judge(&self.opts.grid);
         let all_pass = errors.iter().all(|e| e.pass);
         let mut refined = false;
         let fixed = self.opts.grid.fixed_knots;
         let status = if all_pass {
             FitStatus::Converged
-        } else if self.log.iterations() + 1 >= self.opts.max_iterations {
+        } else if self.log().iterations() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
         } else if self.solves_at_knots < self.opts.solves_per_knots
             && (fixed || failing_share(&errors) <= self.opts.early_split_share)
@@ -320,14 +265,12 @@ impl Fitter for LsqSurfaceFitter {
             FitStatus::MaxIterations
         } else {
             // Halving a span divides the error by about 2^(p + 1) (see split_worst).
-            let p = self
-                .surface
-                .knots_u()
-                .degree()
-                .min(self.surface.knots_v().degree());
-            let quarter_above = crit.tol * 2f64.powi(p as i32 + 1);
+            let s = &self.fit.surface;
+            let p = s.knots_u().degree().min(s.knots_v().degree());
+            let tol = self.opts.grid.criterion(self.fit.state.diagonal()).tol;
+            let quarter_above = tol * 2f64.powi(p as i32 + 1);
             let inserted = split_worst(
-                &mut self.surface,
+                &mut self.fit.surface,
                 &grid,
                 &errors,
                 self.opts.grid.max_control_points,
@@ -341,77 +284,11 @@ impl Fitter for LsqSurfaceFitter {
                 FitStatus::MaxIterations
             }
         };
-        let (nu, nv) = self.surface.num_control();
-        let stats = self.stats();
-        Ok(self.log.record(start, nu * nv, &stats, refined, status))
+        let n = self.fit.surface.control_points().len();
+        Ok(self.fit.state.record(start, n, refined, status))
     }
 
-    fn scheme(&self) -> Scheme {
-        Scheme::BsplineSurface
-    }
-
-    fn method(&self) -> Method {
-        Method::LeastSquares
-    }
-
-    fn log(&self) -> &FitLog {
-        &self.log
-    }
-
-    fn log_mut(&mut self) -> &mut FitLog {
-        &mut self.log
-    }
-
-    fn tolerances(&self) -> Tolerances {
-        Tolerances::max_only(self.opts.grid.tol_pct)
-    }
-
-    fn data(&self) -> &[Point3] {
-        &self.points
-    }
-
-    fn diagonal(&self) -> f64 {
-        self.diagonal
-    }
-
-    fn point_errors(&self) -> &[f64] {
-        &self.dist
-    }
-
-    fn stats(&self) -> ErrorStats {
-        ErrorStats::from_distances(&self.dist, self.diagonal)
-    }
-
-    fn foot_points(&self) -> Vec<Point3> {
-        surface_feet(&self.surface, &self.uv)
-    }
-
-    fn num_control_points(&self) -> usize {
-        self.surface.control_points().len()
-    }
-
-    fn control_shape(&self) -> Shape {
-        control_grid(&self.surface)
-    }
-
-    fn limit_shape(&self, resolution: usize) -> Shape {
-        surface_mesh(&self.surface, resolution)
-    }
-
-    fn iso_lines(&self, resolution: usize) -> Vec<Point3> {
-        iso_lines(&self.surface, resolution)
-    }
-
-    fn spline(&self) -> Option<Spline<'_>> {
-        Some(Spline::Surface {
-            surface: &self.surface,
-            params: &self.uv,
-        })
-    }
-
-    fn details(&self) -> serde_json::Map<String, serde_json::Value> {
-        details(&self.surface, self.num_folded)
-    }
+    surface_fitter_methods!();
 }
 
 /// The factors of β2 and β3 of every patch: 1/ρ and ρ (SPEC §2), with ρ the relative point

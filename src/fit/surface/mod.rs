@@ -4,6 +4,71 @@
 //! ([`SurfaceGrid`]), the parameterisation, the per-patch tolerance test and the drawable
 //! shapes here.
 
+/// The inherent accessors of a surface fitter holding a [`SurfaceFit`] in `fit`.
+macro_rules! surface_accessors {
+    () => {
+        /// The current surface.
+        pub fn surface(&self) -> &BSplineSurface {
+            &self.fit.surface
+        }
+
+        /// Points found on a fold-over of the initial projection.
+        pub fn num_folded(&self) -> usize {
+            self.fit.num_folded
+        }
+
+        /// The foot-point parameters (u, v) of every data point, in data order.
+        pub fn parameters(&self) -> &[[f64; 2]] {
+            &self.fit.uv
+        }
+    };
+}
+
+/// The [`Fitter`](crate::fit::Fitter) methods besides `step` of a surface fitter holding a
+/// [`SurfaceFit`] in `fit`: both methods read their state and draw their shapes alike.
+macro_rules! surface_fitter_methods {
+    () => {
+        fn state(&self) -> &FitState {
+            &self.fit.state
+        }
+
+        fn state_mut(&mut self) -> &mut FitState {
+            &mut self.fit.state
+        }
+
+        fn foot_points(&self) -> Vec<Point3> {
+            super::surface_feet(&self.fit.surface, &self.fit.uv)
+        }
+
+        fn num_control_points(&self) -> usize {
+            self.fit.surface.control_points().len()
+        }
+
+        fn control_shape(&self) -> Shape {
+            super::control_grid(&self.fit.surface)
+        }
+
+        fn limit_shape(&self, resolution: usize) -> Shape {
+            super::surface_mesh(&self.fit.surface, resolution)
+        }
+
+        fn iso_lines(&self, resolution: usize) -> Vec<Point3> {
+            super::iso_lines(&self.fit.surface, resolution)
+        }
+
+        fn spline(&self) -> Option<Spline<'_>> {
+            Some(Spline::Surface {
+                surface: &self.fit.surface,
+                params: &self.fit.uv,
+            })
+        }
+
+        fn details(&self) -> serde_json::Map<String, serde_json::Value> {
+            super::details(&self.fit.surface, self.fit.num_folded)
+        }
+    };
+}
+
 mod geometric;
 mod least_squares;
 mod normal_system;
@@ -17,11 +82,86 @@ pub use parameterize::{
 };
 pub use patches::TolMode;
 
-use super::{FitError, Shape};
+use super::{FitError, FitState, Method, Scheme, Shape, Tolerances};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use crate::spline::{BSplineSurface, KnotVector, SplineError, MAX_DEGREE};
-use patches::Criterion;
+use patches::{correct_parameters, patch_errors, Criterion, PatchError, PatchGrid};
+use web_time::Instant;
+
+/// What both surface methods keep: the shared [`FitState`], which points take part in the fit
+/// (fold-overs may be left out), every point's (u, v), the fold-over count and the surface.
+pub(crate) struct SurfaceFit {
+    pub(crate) state: FitState,
+    pub(crate) active: Vec<bool>,
+    pub(crate) uv: Vec<[f64; 2]>,
+    pub(crate) num_folded: usize,
+    pub(crate) surface: BSplineSurface,
+}
+
+impl SurfaceFit {
+    /// A fit by `method` of `points` at the parameters `param`, from `surface`, judged by
+    /// `grid`'s tolerance, set up since `start`.
+    pub(crate) fn new(
+        method: Method,
+        grid: &SurfaceGrid,
+        points: &[Point3],
+        param: Parameterization,
+        surface: BSplineSurface,
+        start: Instant,
+    ) -> SurfaceFit {
+        let active = (0..points.len())
+            .map(|i| param.is_active(i, grid.param.fold_policy))
+            .collect();
+        let initial = surface.control_points().len();
+        SurfaceFit {
+            state: FitState::new(
+                (Scheme::BsplineSurface, method),
+                Tolerances::max_only(grid.tol_pct),
+                points.to_vec(),
+                initial,
+                start,
+            ),
+            active,
+            uv: param.uv,
+            num_folded: param.num_folded,
+            surface,
+        }
+    }
+
+    /// Parameter correction: every point's foot point by `iterations` warm-started Newton
+    /// steps, then the errors and their statistics.
+    pub(crate) fn correct(&mut self, iterations: usize) {
+        let (points, errors) = self.state.data_and_errors_mut();
+        correct_parameters(&self.surface, points, &mut self.uv, errors, iterations);
+        self.state.errors_changed();
+    }
+
+    /// The patch grid and every patch's error under `grid`'s tolerance test.
+    pub(crate) fn judge(&self, grid: &SurfaceGrid) -> (PatchGrid, Vec<PatchError>) {
+        let patches = PatchGrid::of(&self.surface);
+        let errors = patch_errors(
+            &self.surface,
+            &patches,
+            &self.uv,
+            self.state.errors(),
+            &self.active,
+            grid.criterion(self.state.diagonal()),
+        );
+        (patches, errors)
+    }
+
+    /// The points that take part in the fit, with their parameters.
+    pub(crate) fn samples(&self) -> impl Iterator<Item = (&Point3, &[f64; 2])> {
+        self.state
+            .data()
+            .iter()
+            .zip(&self.uv)
+            .zip(&self.active)
+            .filter(|x| *x.1)
+            .map(|x| x.0)
+    }
+}
 
 /// What both surface methods share: the control grid they start from, how far they may split
 /// it, and how a patch is judged against the tolerance.

@@ -303,7 +303,11 @@ pub(crate) fn correct_parameters(
             *t = near.param;
             let e = *p - near.point;
             let len = e.length();
-            *d = if e.dot(near.direction) < 0.0 { -len } else { len };
+            *d = if e.dot(near.direction) < 0.0 {
+                -len
+            } else {
+                len
+            };
         }
     });
 }

@@ -38,7 +38,11 @@ pub fn refine_marked(
 /// Local remeshing after [`refine_marked`]: valence-lowering and thin-triangle-removing edge
 /// flips around the vertices numbered `first_new` and up (Loop; the quad schemes make none).
 /// Returns the number of changes.
-pub fn remesh(scheme: Scheme, control: &mut PolyMesh, first_new: u32) -> Result<usize, SubdivError> {
+pub fn remesh(
+    scheme: Scheme,
+    control: &mut PolyMesh,
+    first_new: u32,
+) -> Result<usize, SubdivError> {
     match scheme {
         Scheme::Loop => improve_by_flips(control, 3, first_new),
         Scheme::CatmullClark | Scheme::DooSabin => Ok(0),

@@ -6,10 +6,10 @@
 //! new points are the centroid and the edge midpoints of the control polygon; the centroid of
 //! a face is a point of the Doo–Sabin limit surface (face centroids are kept by every step).
 
-use crate::mesh::check_oriented_edges;
-use crate::subdiv::SubdivError;
 use crate::geom::Point3;
+use crate::mesh::check_oriented_edges;
 use crate::mesh::PolyMesh;
+use crate::subdiv::SubdivError;
 use std::collections::HashMap;
 
 /// Splits the `marked` faces of `mesh` (one flag per face) into quads around their centroids

@@ -20,10 +20,10 @@
 //! vertex rule, so where a whole neighbourhood is split the limit surface does not change.
 //! Old vertices keep their indices; edge points and centres follow.
 
-use crate::mesh::{check_oriented_edges, TopologyError};
-use crate::subdiv::{Scheme, SubdivError};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
+use crate::mesh::{check_oriented_edges, TopologyError};
+use crate::subdiv::{Scheme, SubdivError};
 use std::cmp::Reverse;
 use std::collections::{BinaryHeap, HashMap};
 

@@ -6,9 +6,9 @@
 //! does not jump. Remeshing flips edges that lower the valence energy
 //! R(M) = Σ (d(v) − d_opt(v))² or remove long thin triangles, never folding a triangle over.
 
-use crate::subdiv::{Scheme, SubdivError};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::PolyMesh;
+use crate::subdiv::{Scheme, SubdivError};
 use std::collections::{BTreeMap, HashMap};
 
 /// Where the new points of a split come from.

@@ -1,0 +1,131 @@
+//! What every engine keeps the same way: the data points and their scale, each point's signed
+//! error and the statistics of those errors, the tolerances, the scheme and method, and the
+//! [`FitLog`]. [`Fitter`](super::Fitter) reads all of it from here, so an engine implements
+//! only its iteration and its shapes.
+
+use super::{ErrorStats, FitLog, Method, Scheme, Tolerances};
+use crate::geom::{Aabb, Point3};
+use web_time::Instant;
+
+/// The shared state of a fit.
+#[derive(Clone, Debug)]
+pub struct FitState {
+    scheme: Scheme,
+    method: Method,
+    tolerances: Tolerances,
+    data: Vec<Point3>,
+    diagonal: f64,
+    errors: Vec<f64>,
+    stats: ErrorStats,
+    log: FitLog,
+}
+
+impl FitState {
+    /// The state of a fit of `data` (finite points) that starts with `initial_control`
+    /// control points, set up since `start`. Errors are zero until [`FitState::set_errors`].
+    pub(crate) fn new(
+        (scheme, method): (Scheme, Method),
+        tolerances: Tolerances,
+        data: Vec<Point3>,
+        initial_control: usize,
+        start: Instant,
+    ) -> FitState {
+        let diagonal = Aabb::from_points(&data).map_or(0.0, |b| b.diagonal());
+        FitState {
+            scheme,
+            method,
+            tolerances,
+            errors: vec![0.0; data.len()],
+            data,
+            diagonal: if diagonal > 0.0 { diagonal } else { 1.0 },
+            stats: ErrorStats::default(),
+            log: FitLog::new(initial_control, start),
+        }
+    }
+
+    /// The scheme fitted.
+    pub fn scheme(&self) -> Scheme {
+        self.scheme
+    }
+
+    /// The method fitted with.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// The tolerances the fit stops at.
+    pub fn tolerances(&self) -> Tolerances {
+        self.tolerances
+    }
+
+    /// The data points, in input order.
+    pub fn data(&self) -> &[Point3] {
+        &self.data
+    }
+
+    /// Diagonal of the data's bounding box (1 for data without extent): what the `_pct` figures
+    /// are relative to.
+    pub fn diagonal(&self) -> f64 {
+        self.diagonal
+    }
+
+    /// Signed distance of every data point to the surface or curve, model units.
+    pub fn errors(&self) -> &[f64] {
+        &self.errors
+    }
+
+    /// Statistics of [`FitState::errors`].
+    pub fn stats(&self) -> ErrorStats {
+        self.stats
+    }
+
+    /// The history and status.
+    pub fn log(&self) -> &FitLog {
+        &self.log
+    }
+
+    /// The history and status, to record an iteration or add set-up time.
+    pub fn log_mut(&mut self) -> &mut FitLog {
+        &mut self.log
+    }
+
+    /// Whether the statistics meet every tolerance.
+    pub(crate) fn met(&self) -> bool {
+        self.tolerances.met_by(&self.stats)
+    }
+
+    /// The data points and the errors to overwrite, at once; call
+    /// [`FitState::errors_changed`] after.
+    pub(crate) fn data_and_errors_mut(&mut self) -> (&[Point3], &mut [f64]) {
+        (&self.data, &mut self.errors)
+    }
+
+    /// Recomputes the statistics after the errors changed.
+    pub(crate) fn errors_changed(&mut self) {
+        self.stats = ErrorStats::from_distances(&self.errors, self.diagonal);
+    }
+
+    /// Replaces the errors and their statistics.
+    pub(crate) fn set_errors(&mut self, errors: Vec<f64>) {
+        self.errors = errors;
+        self.errors_changed();
+    }
+
+    /// Restores errors and statistics saved before a rejected move.
+    pub(crate) fn restore(&mut self, errors: Vec<f64>, stats: ErrorStats) {
+        self.errors = errors;
+        self.stats = stats;
+    }
+
+    /// Closes the iteration that began at `start` with `control_points` control points.
+    pub(crate) fn record(
+        &mut self,
+        start: Instant,
+        control_points: usize,
+        refined: bool,
+        status: super::FitStatus,
+    ) -> super::FitStatus {
+        self.log
+            .record(start, control_points, &self.stats, refined, status)
+    }
+}

@@ -1,0 +1,137 @@
+// @ts-check
+// Drawing helpers of the fitting panel: the error colour scale, line sets for the viewer and
+// the convergence chart. Pure functions of their inputs; no state.
+
+// Diverging map for signed distance: inside the E_max tolerance pale tints, outside saturated.
+const INSIDE_NEG = [0.62, 0.78, 1.0];
+const INSIDE_ZERO = [0.92, 0.92, 0.9];
+const INSIDE_POS = [1.0, 0.74, 0.62];
+const OUTSIDE_NEG = [0.05, 0.25, 0.95];
+const OUTSIDE_POS = [0.9, 0.08, 0.05];
+export const VECTOR_COLOR = [1.0, 0.85, 0.2];
+export const CAGE_COLOR = [0.35, 0.95, 0.55];
+export const ISO_COLOR = [0.3, 0.85, 1.0];
+export const INITIAL_COLOR = [0.75, 0.55, 1.0];
+export const CURVE_COLOR = [1.0, 0.55, 0.1];
+// The chart is drawn on the CPU: a GPU-accelerated 2D canvas makes the main thread wait for the
+// GPU process (seconds under software rendering on a loaded machine) when the page is composited.
+export const CHART_CONTEXT = { willReadFrequently: true };
+const CHART_COLORS = { eAvgPct: '#4ea1ff', eMaxPct: '#ff6b5b', eRmsPct: '#7ee07e' };
+
+function mix(a, b, t) {
+  return [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t];
+}
+
+/** One sRGB colour per data point from its signed distance `d` and the tolerance `tol` (units). */
+export function errorColors(errors, tol) {
+  const colors = new Float32Array(errors.length * 3);
+  for (let i = 0; i < errors.length; i += 1) {
+    const t = tol > 0 ? errors[i] / tol : 0;
+    let c;
+    if (t > 1) c = OUTSIDE_POS;
+    else if (t < -1) c = OUTSIDE_NEG;
+    else if (t >= 0) c = mix(INSIDE_ZERO, INSIDE_POS, t);
+    else c = mix(INSIDE_ZERO, INSIDE_NEG, -t);
+    colors.set(c, i * 3);
+  }
+  return colors;
+}
+
+/** Segment end points (two per edge) of the indexed `edges` over flat `positions`. */
+export function edgeSegments(positions, edges) {
+  const out = new Float32Array(edges.length * 3);
+  for (let k = 0; k < edges.length; k += 1) out.set(positions.subarray(edges[k] * 3, edges[k] * 3 + 3), k * 3);
+  return out;
+}
+
+/** One line set from `[segments, colour]` parts: flat positions and a colour per vertex. */
+export function lineSet(parts) {
+  const total = parts.reduce((n, [p]) => n + p.length, 0);
+  const positions = new Float32Array(total);
+  const colors = new Float32Array(total);
+  let at = 0;
+  for (const [p, color] of parts) {
+    positions.set(p, at);
+    for (let i = at; i < at + p.length; i += 3) colors.set(color, i);
+    at += p.length;
+  }
+  return { positions, colors };
+}
+
+export function fmtPct(v) {
+  return `${v.toPrecision(4)} %`;
+}
+
+export function fmtUnits(v) {
+  return v === 0 ? '0' : v.toExponential(3);
+}
+
+/** Draws E_avg, E_max, E_rms (log scale) against iteration, tolerance lines and refinements. */
+export function drawChart(canvas, history, tolerances) {
+  const ratio = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * ratio));
+  const h = Math.max(1, Math.round(canvas.clientHeight * ratio));
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+  }
+  const g = canvas.getContext('2d', CHART_CONTEXT);
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  const cw = w / ratio;
+  const ch = h / ratio;
+  g.fillStyle = '#10141b';
+  g.fillRect(0, 0, cw, ch);
+  const pad = { l: 44, r: 8, t: 8, b: 20 };
+  const values = history.flatMap((r) => [r.eAvgPct, r.eMaxPct, r.eRmsPct]);
+  for (const t of Object.values(tolerances)) if (t > 0) values.push(t);
+  const positive = values.filter((v) => v > 0);
+  if (positive.length === 0) return;
+  let lo = Math.log10(Math.min(...positive));
+  let hi = Math.log10(Math.max(...positive));
+  lo = Math.floor(lo);
+  hi = Math.max(Math.ceil(hi), lo + 1);
+  const n = Math.max(history.length, 1);
+  const x = (i) => pad.l + ((i) / n) * (cw - pad.l - pad.r);
+  const y = (v) => pad.t + ((hi - Math.log10(Math.max(v, 10 ** lo))) / (hi - lo)) * (ch - pad.t - pad.b);
+  g.font = '10px system-ui, sans-serif';
+  g.fillStyle = '#9aa3ad';
+  g.strokeStyle = '#2a313c';
+  g.lineWidth = 1;
+  for (let e = lo; e <= hi; e += 1) {
+    g.beginPath();
+    g.moveTo(pad.l, y(10 ** e));
+    g.lineTo(cw - pad.r, y(10 ** e));
+    g.stroke();
+    g.fillText(`${10 ** e >= 1 ? 10 ** e : (10 ** e).toPrecision(1)}%`, 2, y(10 ** e) + 3);
+  }
+  g.fillText('iteration', cw - 50, ch - 4);
+  // Refinement events: dashed vertical lines.
+  g.setLineDash([3, 3]);
+  g.strokeStyle = '#c9a0ff';
+  for (const r of history) {
+    if (!r.refined) continue;
+    g.beginPath();
+    g.moveTo(x(r.iter), pad.t);
+    g.lineTo(x(r.iter), ch - pad.b);
+    g.stroke();
+  }
+  // Tolerances: dashed horizontal lines in the colour of their figure.
+  const tolKey = { avg: 'eAvgPct', max: 'eMaxPct', rms: 'eRmsPct' };
+  for (const [k, t] of Object.entries(tolerances)) {
+    if (!(t > 0)) continue;
+    g.strokeStyle = CHART_COLORS[tolKey[k]];
+    g.beginPath();
+    g.moveTo(pad.l, y(t));
+    g.lineTo(cw - pad.r, y(t));
+    g.stroke();
+  }
+  g.setLineDash([]);
+  g.lineWidth = 2;
+  for (const [key, color] of Object.entries(CHART_COLORS)) {
+    g.strokeStyle = color;
+    g.beginPath();
+    history.forEach((r, i) => (i === 0 ? g.moveTo(x(r.iter), y(r[key])) : g.lineTo(x(r.iter), y(r[key]))));
+    if (history.length === 1) g.lineTo(x(history[0].iter) + 2, y(history[0][key]));
+    g.stroke();
+  }
+}

@@ -1,0 +1,64 @@
+// @ts-check
+// The messages between the page (fit-ui.js) and the fitting worker (fit-worker.js), in one
+// place. Every message carries the `generation` of the fit it belongs to, so the page drops
+// what an older fit sent. Bulk data travel as transferable typed arrays.
+
+/** @typedef {import('../pkg/geofit.js').Fitter} Fitter */
+
+/**
+ * Page → worker.
+ * @typedef {{ type: 'start', generation: number, bytes: Uint8Array, name: string, spec: Object<string, unknown> }} StartMessage
+ *   Read `bytes` (a file called `name`) and build a fit with the options object `spec` (the
+ *   core's FitSpec, camelCase; left-out fields take the core's defaults).
+ * @typedef {{ type: 'play' | 'pause' | 'step' }} DriveMessage
+ *   Iterate in slices until stopped or paused; stop; one iteration.
+ * @typedef {{ type: 'export', what: string }} ExportMessage
+ *   Export the fit (`what` from `exportsFor(scheme)`).
+ * @typedef {{ type: 'clear', generation: number }} ClearMessage
+ *   Forget the fit (a new file was loaded).
+ * @typedef {StartMessage | DriveMessage | ExportMessage | ClearMessage} ToWorker
+ */
+
+/**
+ * Worker → page.
+ * @typedef {{ positions: Float32Array, normals: Float32Array, indices: Uint32Array, edges: Uint32Array }} Shape
+ * @typedef {{
+ *   type: 'frame', kind: 'start' | 'play' | 'pause' | 'step', generation: number, playing: boolean,
+ *   stats: Object<string, any>, history: Object<string, any>[], errors: Float32Array,
+ *   limit: Shape, control: { positions: Float32Array, edges: Uint32Array },
+ *   vectors: Float32Array, iso: Float32Array,
+ *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array } },
+ * }} FrameMessage
+ *   The state of the fit after a slice; `once` (data points and initial control net) only on
+ *   the first frame of a fit.
+ * @typedef {{ type: 'exported', what: string, bytes: Uint8Array }} ExportedMessage
+ * @typedef {{ type: 'error', during: string, generation: number, message: string }} ErrorMessage
+ * @typedef {FrameMessage | ExportedMessage | ErrorMessage} FromWorker
+ */
+
+/** The message types, so neither side spells them twice. */
+export const MSG = Object.freeze({
+  start: 'start',
+  play: 'play',
+  pause: 'pause',
+  step: 'step',
+  export: 'export',
+  clear: 'clear',
+  frame: 'frame',
+  exported: 'exported',
+  error: 'error',
+});
+
+/**
+ * The typed arrays of a frame, to transfer instead of copying.
+ * @param {FrameMessage} frame
+ * @returns {ArrayBufferLike[]}
+ */
+export function frameTransfers(frame) {
+  const arrays = [
+    frame.errors, frame.limit.positions, frame.limit.normals, frame.limit.indices, frame.limit.edges,
+    frame.control.positions, frame.control.edges, frame.vectors, frame.iso,
+  ];
+  if (frame.once) arrays.push(frame.once.data, frame.once.initial.positions, frame.once.initial.edges);
+  return arrays.map((a) => a.buffer);
+}
