@@ -322,7 +322,7 @@ fn bad_input_gives_typed_errors() {
     ));
     assert!(matches!(
         LsqSurfaceFitter::try_new(&dome(10, &mut Rng(1)), opts.with_control(3, 8)),
-        Err(FitError::InvalidOption { name: "ctrl", .. })
+        Err(FitError::InvalidOption { name: "grid", .. })
     ));
     assert!(matches!(
         LsqSurfaceFitter::try_new(

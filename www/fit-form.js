@@ -64,7 +64,7 @@ export class FitForm {
     for (const label of this.form.querySelectorAll('[data-option]')) {
       /** @type {HTMLElement} */ (label).hidden = !applies.has(/** @type {HTMLElement} */ (label).dataset.option ?? '');
     }
-    const defaults = defaultSpec(this.scheme.value);
+    const defaults = defaultSpec(this.scheme.value, this.method.value || undefined);
     for (const control of this.controls()) {
       if (this.edited.has(control.name) || control.name === 'method') continue;
       // A list with an empty choice offers "the core's default", which may depend on other

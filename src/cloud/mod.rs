@@ -95,33 +95,20 @@ impl Default for ReconstructOptions {
     }
 }
 
-impl ReconstructOptions {
+setters!(ReconstructOptions {
     /// Sets [`ReconstructOptions::kind`].
-    pub fn with_kind(mut self, kind: Option<SurfaceKind>) -> ReconstructOptions {
-        self.kind = kind;
-        self
-    }
+    with_kind(kind: Option<SurfaceKind>) => |s| s.kind;
     /// Sets [`ReconstructOptions::neighbours`].
-    pub fn with_neighbours(mut self, k: usize) -> ReconstructOptions {
-        self.neighbours = k;
-        self
-    }
+    with_neighbours(k: usize) => |s| s.neighbours;
     /// Sets [`ReconstructOptions::long_edge_factor`].
-    pub fn with_long_edge_factor(mut self, factor: f64) -> ReconstructOptions {
-        self.long_edge_factor = factor;
-        self
-    }
+    with_long_edge_factor(factor: f64) => |s| s.long_edge_factor;
     /// Sets [`ReconstructOptions::cell_size`].
-    pub fn with_cell_size(mut self, spacings: f64) -> ReconstructOptions {
-        self.cell_size = spacings;
-        self
-    }
+    with_cell_size(spacings: f64) => |s| s.cell_size;
     /// Sets [`ReconstructOptions::outlier_std_ratio`].
-    pub fn with_outlier_std_ratio(mut self, ratio: Option<f64>) -> ReconstructOptions {
-        self.outlier_std_ratio = ratio;
-        self
-    }
+    with_outlier_std_ratio(ratio: Option<f64>) => |s| s.outlier_std_ratio;
+});
 
+impl ReconstructOptions {
     fn validate(&self) -> Result<(), ReconstructError> {
         let bad = |name, value: f64, expected| {
             Err(ReconstructError::InvalidOption {

@@ -447,6 +447,21 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
     ),
 ];
 
+/// Calls `$m!` with every field of [`FitSpec`] but the scheme, each with its name: the one list
+/// that checking what was given and clearing what does not apply both walk.
+macro_rules! spec_fields {
+    ($m:ident) => {
+        $m!(method: "method", tol_avg: "tolAvg", tol_max: "tolMax", tol_rms: "tolRms",
+            initial: "initial", grid: "grid", max_iter: "maxIter", refine: "refine",
+            max_control: "maxControl", weights: "weights", acceleration: "acceleration",
+            tangent_weight: "tangentWeight", refine_growth: "refineGrowth", remesh: "remesh",
+            cloud: "cloud", outliers: "outliers", use_grid: "useGrid", closed: "closed",
+            degree: "degree", tol_mode: "tolMode", beta2: "beta2", beta3: "beta3",
+            solves: "solves", view: "view", folded: "folded", corner_angle: "cornerAngle",
+            curvature_jump: "curvatureJump")
+    };
+}
+
 impl Default for FitSpec {
     fn default() -> Self {
         FitSpec::DEFAULT
@@ -513,8 +528,21 @@ impl FitSpec {
     /// (`initial` and `maxControl` of subdivision, `closed` of curves), and options the scheme
     /// does not use.
     pub fn defaults(scheme: Scheme) -> FitSpec {
-        let spec = FitSpec::new(scheme);
-        let method = spec.method();
+        FitSpec::defaults_with(scheme, scheme.default_method())
+    }
+
+    /// [`FitSpec::defaults`] for `method` (one of the scheme's methods; another gives the
+    /// defaults of the scheme's own method).
+    pub fn defaults_with(scheme: Scheme, method: Method) -> FitSpec {
+        let method = if scheme.methods().contains(&method) {
+            method
+        } else {
+            scheme.default_method()
+        };
+        let spec = FitSpec {
+            method: Some(method),
+            ..FitSpec::new(scheme)
+        };
         let tol = spec.tolerances();
         let mut d = FitSpec {
             method: Some(method),
@@ -566,16 +594,7 @@ impl FitSpec {
                 $(if !keep($name) { self.$field = d.$field.clone(); })*
             };
         }
-        clear!(tol_avg: "tolAvg", tol_rms: "tolRms", initial: "initial", grid: "grid",
-            max_control: "maxControl", weights: "weights", acceleration: "acceleration",
-            tangent_weight: "tangentWeight", refine_growth: "refineGrowth", remesh: "remesh",
-            cloud: "cloud", outliers: "outliers", use_grid: "useGrid", closed: "closed",
-            degree: "degree", tol_mode: "tolMode", beta2: "beta2", beta3: "beta3",
-            solves: "solves", view: "view", folded: "folded", corner_angle: "cornerAngle",
-            curvature_jump: "curvatureJump");
-        if !keep("method") {
-            self.method = None;
-        }
+        spec_fields!(clear);
     }
 
     /// The names of the fields set away from [`FitSpec::DEFAULT`].
@@ -587,14 +606,7 @@ impl FitSpec {
                 $(if self.$field != d.$field { out.push($name); })*
             };
         }
-        given!(method: "method", tol_avg: "tolAvg", tol_max: "tolMax", tol_rms: "tolRms",
-            initial: "initial", grid: "grid", max_iter: "maxIter", refine: "refine",
-            max_control: "maxControl", weights: "weights", acceleration: "acceleration",
-            tangent_weight: "tangentWeight", refine_growth: "refineGrowth", remesh: "remesh",
-            cloud: "cloud", outliers: "outliers", use_grid: "useGrid", closed: "closed",
-            degree: "degree", tol_mode: "tolMode", beta2: "beta2", beta3: "beta3",
-            solves: "solves", view: "view", folded: "folded", corner_angle: "cornerAngle",
-            curvature_jump: "curvatureJump");
+        spec_fields!(given);
         out
     }
 

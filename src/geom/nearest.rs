@@ -48,21 +48,15 @@ impl NewtonOptions {
         max_step: f64::INFINITY,
     };
 
-    /// Sets the iteration cap.
-    pub fn with_max_iter(mut self, n: usize) -> Self {
+    /// Sets the iteration cap (a `const fn`, for options built in constants).
+    pub const fn with_max_iter(mut self, n: usize) -> Self {
         self.max_iter = n;
         self
     }
 
-    /// Sets the step tolerance.
-    pub fn with_step_tol(mut self, tol: f64) -> Self {
+    /// Sets the step tolerance (a `const fn`).
+    pub const fn with_step_tol(mut self, tol: f64) -> Self {
         self.step_tol = tol;
-        self
-    }
-
-    /// Sets the largest parameter step.
-    pub fn with_max_step(mut self, step: f64) -> Self {
-        self.max_step = step;
         self
     }
 

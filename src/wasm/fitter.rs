@@ -34,25 +34,31 @@ fn to_js(value: &impl Serialize) -> Result<JsValue, JsError> {
     Ok(value.serialize(&serializer)?)
 }
 
-/// The options object of `scheme` with every default written out, as the core uses it:
-/// `{scheme, method, tolAvg, tolMax, ...}`; `null` where the data decides (`initial` and
-/// `maxControl` of subdivision surfaces, `closed` of curves) or the scheme has no such option.
-/// Throws on an unknown scheme name.
+/// The options object of `scheme` fitted by `method` (its default method when left out) with
+/// every default written out, as the core uses it: `{scheme, method, tolAvg, tolMax, ...}`;
+/// `null` where the data decides (`initial` and `maxControl` of subdivision surfaces, `closed`
+/// of curves) or the scheme has no such option. Throws on an unknown name.
 #[wasm_bindgen(js_name = defaultSpec)]
-pub fn default_spec(scheme: &str) -> Result<JsValue, JsError> {
+pub fn default_spec(scheme: &str, method: Option<String>) -> Result<JsValue, JsError> {
+    let (scheme, method) = scheme_and_method(scheme, method)?;
+    to_js(&FitSpec::defaults_with(scheme, method))
+}
+
+/// `scheme` and `method` (the scheme's default when `None`) from their names.
+fn scheme_and_method(scheme: &str, method: Option<String>) -> Result<(Scheme, Method), JsError> {
     let scheme: Scheme = scheme.parse().map_err(|e: String| JsError::new(&e))?;
-    to_js(&FitSpec::defaults(scheme))
+    let method = match method {
+        Some(m) => m.parse().map_err(|e: String| JsError::new(&e))?,
+        None => scheme.default_method(),
+    };
+    Ok((scheme, method))
 }
 
 /// The names of the options that take part in a fit of `scheme` by `method` (the scheme's
 /// default method when `method` is left out). Throws on an unknown name.
 #[wasm_bindgen(js_name = optionsFor)]
 pub fn options_for(scheme: &str, method: Option<String>) -> Result<Vec<String>, JsError> {
-    let scheme: Scheme = scheme.parse().map_err(|e: String| JsError::new(&e))?;
-    let method = match method {
-        Some(m) => m.parse().map_err(|e: String| JsError::new(&e))?,
-        None => scheme.default_method(),
-    };
+    let (scheme, method) = scheme_and_method(scheme, method)?;
     Ok(FitSpec::options_for(scheme, method)
         .into_iter()
         .map(String::from)

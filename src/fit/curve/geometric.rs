@@ -68,12 +68,12 @@ impl CurveFitOptions {
         check_degree(self.degree)?;
         if !(self.simplify_pct.is_finite() && self.simplify_pct > 0.0) {
             return bad(
-                "simplifyPct",
+                "simplify_pct",
                 format!("{} must be positive", self.simplify_pct),
             );
         }
         if self.refine_interval == 0 {
-            return bad("refineInterval", "must be at least 1".into());
+            return bad("refine_interval", "must be at least 1".into());
         }
         self.tolerances.validate()?;
         self.acceleration.validate()

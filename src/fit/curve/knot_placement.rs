@@ -89,7 +89,7 @@ impl KnotPlacementOptions {
             );
         }
         if let Some(s) = self.std_pct.filter(|s| !(s.is_finite() && *s >= 0.0)) {
-            return bad("tolStd", format!("{s} is not a non-negative percentage"));
+            return bad("std_pct", format!("{s} is not a non-negative percentage"));
         }
         self.tolerances.validate()
     }

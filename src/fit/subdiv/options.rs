@@ -104,14 +104,14 @@ impl SubdivFitOptions {
             return bad("maxIter", "must be at least 1".into());
         }
         if self.refine_interval == 0 {
-            return bad("refineInterval", "must be at least 1".into());
+            return bad("refine_interval", "must be at least 1".into());
         }
         if !(self.refine_growth.is_finite() && self.refine_growth > 0.0) {
             return bad("refineGrowth", format!("{} is not > 0", self.refine_growth));
         }
         if !(self.stall_ratio.is_finite() && (0.0..1.0).contains(&self.stall_ratio)) {
             return bad(
-                "stallRatio",
+                "stall_ratio",
                 format!("{} is not in [0, 1)", self.stall_ratio),
             );
         }
@@ -142,7 +142,7 @@ impl SubdivFitOptions {
         }
         if !(1..=32).contains(&self.index_resolution) {
             return bad(
-                "indexResolution",
+                "index_resolution",
                 format!("{} is not in 1..=32", self.index_resolution),
             );
         }

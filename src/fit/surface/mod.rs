@@ -287,7 +287,7 @@ pub(crate) fn check_early_split_share(share: f64) -> Result<(), FitError> {
         return Ok(());
     }
     Err(FitError::InvalidOption {
-        name: "earlySplitShare",
+        name: "early_split_share",
         reason: format!("{share} is outside 0..=1"),
     })
 }
