@@ -9,7 +9,7 @@ bash scripts/install.sh
 # The wasm profile (Cargo.toml) trades build time for a smaller, faster .wasm.
 cargo build --profile wasm-release --target wasm32-unknown-unknown --lib
 wasm-bindgen --target web --out-dir pkg \
-    target/wasm32-unknown-unknown/wasm-release/geofit.wasm
+    "${CARGO_TARGET_DIR:-target}/wasm32-unknown-unknown/wasm-release/geofit.wasm"
 
 # The features Rust's wasm32 target emits by default; wasm-opt must accept them, and may use no others.
 node_modules/.bin/wasm-opt -Oz \

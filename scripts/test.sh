@@ -45,7 +45,7 @@ run_interop() {
     # a failure (pytest would collect no test functions from them and exit 5).
     local f
     for f in "${files[@]}"; do
-        GEOFIT_BIN="$PWD/target/release/geofit" .venv/bin/python "$f"
+        GEOFIT_BIN="$(realpath "${CARGO_TARGET_DIR:-target}")/release/geofit" .venv/bin/python "$f"
     done
 }
 

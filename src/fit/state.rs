@@ -117,6 +117,18 @@ impl FitState {
         self.stats = stats;
     }
 
+    /// The status after the iteration now ending: converged when `met`, stopped when it is the
+    /// `cap`-th, else running on.
+    pub(crate) fn status_after(&self, met: bool, cap: usize) -> super::FitStatus {
+        if met {
+            super::FitStatus::Converged
+        } else if self.log.iterations() + 1 >= cap {
+            super::FitStatus::MaxIterations
+        } else {
+            super::FitStatus::Running
+        }
+    }
+
     /// Closes the iteration that began at `start` with `control_points` control points.
     pub(crate) fn record(
         &mut self,

@@ -13,7 +13,7 @@ use geofit::fit::{
 use geofit::geom::Vec3;
 use geofit::spline::BSplineSurface;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `geofit fit`. Left out, an option takes the core's default for the scheme
@@ -394,53 +394,69 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
 
 /// Writes the files asked for.
 fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
-    let write = |path: &Path, bytes: &[u8]| {
-        std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
-    };
     let name = args
         .file
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("geofit");
-    if let Some(path) = &args.json {
-        let text =
-            serde_json::to_string_pretty(&FitReport::of(fitter)).map_err(|e| e.to_string())?;
-        write(path, text.as_bytes())?;
-    }
-    if let Some(path) = &args.cage {
-        write(path, &export::cage_obj(fitter).map_err(|e| e.to_string())?)?;
-    }
-    if let (Some(path), Shape::Mesh(mesh)) = (&args.limit, fitter.limit_shape(args.limit_segments))
-    {
-        write(
-            path,
-            &geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string())?,
-        )?;
-    }
-    if let Some(path) = &args.iges {
-        write(
-            path,
-            export::iges_of(fitter, name)
-                .map_err(|e| e.to_string())?
-                .as_bytes(),
-        )?;
-    }
-    if let Some(path) = &args.step {
-        write(
-            path,
-            export::step_of(fitter, name)
-                .map_err(|e| e.to_string())?
-                .as_bytes(),
-        )?;
-    }
-    if let (Some(path), Some(Spline::Surface { surface, params })) =
-        (&args.surface_json, fitter.spline())
-    {
-        let json =
-            serde_json::to_string(&surface_json(surface, params)).map_err(|e| e.to_string())?;
-        write(path, json.as_bytes())?;
+    let text = |r: Result<String, export::ExportError>| r.map(String::into_bytes);
+    type Make<'a> = Box<dyn Fn() -> Result<Vec<u8>, String> + 'a>;
+    let outputs: [(&Option<PathBuf>, Make); 6] = [
+        (
+            &args.json,
+            Box::new(|| json_text(&FitReport::of(fitter), true)),
+        ),
+        (
+            &args.cage,
+            Box::new(|| export::cage_obj(fitter).map_err(|e| e.to_string())),
+        ),
+        (
+            &args.limit,
+            Box::new(|| limit_obj(fitter, args.limit_segments)),
+        ),
+        (
+            &args.iges,
+            Box::new(|| text(export::iges_of(fitter, name)).map_err(|e| e.to_string())),
+        ),
+        (
+            &args.step,
+            Box::new(|| text(export::step_of(fitter, name)).map_err(|e| e.to_string())),
+        ),
+        (&args.surface_json, Box::new(|| surface_json(fitter))),
+    ];
+    for (path, make) in outputs {
+        if let Some(path) = path {
+            let bytes = make()?;
+            std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
     }
     Ok(())
+}
+
+/// `value` as JSON text, indented when `pretty`.
+fn json_text(value: &impl Serialize, pretty: bool) -> Result<Vec<u8>, String> {
+    let text = if pretty {
+        serde_json::to_string_pretty(value)
+    } else {
+        serde_json::to_string(value)
+    };
+    text.map(String::into_bytes).map_err(|e| e.to_string())
+}
+
+/// The fitted surface tessellated with `segments` per patch edge, as OBJ.
+fn limit_obj(fitter: &dyn Fitter, segments: usize) -> Result<Vec<u8>, String> {
+    match fitter.limit_shape(segments) {
+        Shape::Mesh(mesh) => geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string()),
+        Shape::Polyline { .. } => Err("--limit: a curve has no surface".into()),
+    }
+}
+
+/// A B-spline surface fit's surface and the data points' parameters on it, as JSON.
+fn surface_json(fitter: &dyn Fitter) -> Result<Vec<u8>, String> {
+    let Some(Spline::Surface { surface, params }) = fitter.spline() else {
+        return Err("--surface-json: the fit has no B-spline surface".into());
+    };
+    json_text(&SurfaceJson::of(surface, params), false)
 }
 
 /// The fitted surface as plain data.
@@ -458,16 +474,18 @@ struct SurfaceJson<'a> {
     parameters: &'a [[f64; 2]],
 }
 
-fn surface_json<'a>(s: &'a BSplineSurface, parameters: &'a [[f64; 2]]) -> SurfaceJson<'a> {
-    let (nu, nv) = s.num_control();
-    SurfaceJson {
-        degree_u: s.knots_u().degree(),
-        degree_v: s.knots_v().degree(),
-        knots_u: s.knots_u().knots(),
-        knots_v: s.knots_v().knots(),
-        control_points_u: nu,
-        control_points_v: nv,
-        control_points: s.control_points().iter().map(|p| p.to_array()).collect(),
-        parameters,
+impl<'a> SurfaceJson<'a> {
+    fn of(s: &'a BSplineSurface, parameters: &'a [[f64; 2]]) -> SurfaceJson<'a> {
+        let (nu, nv) = s.num_control();
+        SurfaceJson {
+            degree_u: s.knots_u().degree(),
+            degree_v: s.knots_v().degree(),
+            knots_u: s.knots_u().knots(),
+            knots_v: s.knots_v().knots(),
+            control_points_u: nu,
+            control_points_v: nv,
+            control_points: s.control_points().iter().map(|p| p.to_array()).collect(),
+            parameters,
+        }
     }
 }

@@ -390,13 +390,7 @@ impl Fitter for CurveFitter {
         if refined {
             self.since_refine = 0;
         }
-        let status = if met {
-            FitStatus::Converged
-        } else if self.log().iterations() + 1 >= self.options.max_iter {
-            FitStatus::MaxIterations
-        } else {
-            FitStatus::Running
-        };
+        let status = self.state.status_after(met, self.options.max_iter);
         let n = self.curve.control_points().len();
         Ok(self.state.record(start, n, refined, status))
     }

@@ -476,13 +476,7 @@ impl Fitter for KnotPlacementFitter {
         )?;
         self.curve = least_squares_curve(&template, &self.data.points, &self.params)?;
         self.measure();
-        let status = if self.met() {
-            FitStatus::Converged
-        } else if self.log().iterations() + 1 >= cap {
-            FitStatus::MaxIterations
-        } else {
-            FitStatus::Running
-        };
+        let status = self.state.status_after(self.met(), cap);
         let n = self.curve.control_points().len();
         Ok(self.state.record(start, n, true, status))
     }

@@ -498,13 +498,9 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
                 self.since_refine = 0;
             }
         }
-        let status = if self.state.met() {
-            FitStatus::Converged
-        } else if self.log().iterations() + 1 >= self.options.max_iter {
-            FitStatus::MaxIterations
-        } else {
-            FitStatus::Running
-        };
+        let status = self
+            .state
+            .status_after(self.state.met(), self.options.max_iter);
         let n = self.num_control_points();
         Ok(self.state.record(start, n, refined, status))
     }
