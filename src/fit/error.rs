@@ -75,15 +75,51 @@ pub enum FitError {
     #[error("invalid control mesh: the data has no faces; reconstruct a mesh from the points or give a control mesh")]
     NoFaces,
     /// The control mesh (given, or made by simplification) has no faces.
+    ///
+    /// ```
+    /// use geofit::fit::FitError;
+    /// assert_eq!(
+    ///     FitError::EmptyControlMesh.to_string(),
+    ///     "invalid control mesh: the control mesh has no faces"
+    /// );
+    /// ```
     #[error("invalid control mesh: the control mesh has no faces")]
     EmptyControlMesh,
     /// The control mesh is not a valid oriented manifold for subdivision.
+    ///
+    /// ```
+    /// use geofit::fit::{surface_of, FitError};
+    /// use geofit::geom::Point3;
+    /// use geofit::mesh::PolyMesh;
+    /// use geofit::subdiv::Scheme;
+    /// // Two triangles that run their shared edge the same way.
+    /// let p = vec![Point3::ZERO, Point3::X, Point3::Y, Point3::ONE];
+    /// let mesh = PolyMesh::try_new(p, vec![[0, 1, 2], [0, 1, 3]]).unwrap();
+    /// let err = surface_of(Scheme::Loop, &mesh).err();
+    /// assert!(matches!(err, Some(FitError::ControlMesh(_))), "{err:?}");
+    /// ```
     #[error("invalid control mesh: {0}")]
     ControlMesh(#[from] TopologyError),
     /// QEM simplification could not make the initial control mesh.
+    ///
+    /// ```
+    /// use geofit::fit::{initial_control, FitError};
+    /// use geofit::geom::Point3;
+    /// use geofit::mesh::PolyMesh;
+    /// let p = vec![Point3::ZERO, Point3::X, Point3::Y];
+    /// let tri = PolyMesh::try_new(p, vec![[0, 1, 2]]).unwrap();
+    /// let err = initial_control(&tri, Some(10)).err();
+    /// assert!(matches!(err, Some(FitError::Simplify(_))), "{err:?}");
+    /// ```
     #[error("invalid control mesh: simplification: {0}")]
     Simplify(#[from] SimplifyError),
     /// The limit surface has no finite point near a data point (a degenerate control mesh).
+    ///
+    /// ```
+    /// use geofit::fit::FitError;
+    /// let e = FitError::NoSurfaceNear { point: 7 };
+    /// assert_eq!(e.to_string(), "the limit surface has no finite point near data point 7");
+    /// ```
     #[error("the limit surface has no finite point near data point {point}")]
     NoSurfaceNear {
         /// The data point.
@@ -104,27 +140,84 @@ pub enum FitError {
         index: usize,
     },
     /// A data point repeats the one before it, so the polyline has a zero-length segment.
+    ///
+    /// ```
+    /// use geofit::fit::{CurveFitOptions, CurveFitter, FitError};
+    /// use geofit::geom::Point3;
+    /// let pts = [Point3::ZERO, Point3::X, Point3::X, Point3::Y, Point3::Z];
+    /// let err = CurveFitter::try_new(&pts, CurveFitOptions::default()).err();
+    /// assert_eq!(err, Some(FitError::DuplicatePoint { index: 2 }));
+    /// ```
     #[error("data point {index} repeats the point before it")]
     DuplicatePoint {
         /// Index of the repeated point in the input.
         index: usize,
     },
     /// Bare points could not be turned into a mesh to start from.
+    ///
+    /// ```
+    /// use geofit::fit::{FitData, FitError, FitSpec, Scheme};
+    /// use geofit::geom::Point3;
+    /// use geofit::mesh::PolyMesh;
+    /// let two = PolyMesh::from_points(vec![Point3::ZERO, Point3::X]).unwrap();
+    /// let err = FitSpec::new(Scheme::Loop).build(&FitData::points(&two)).err();
+    /// assert!(matches!(err, Some(FitError::Reconstruct(_))));
+    /// ```
     #[error("reconstructing a surface from the points: {0}")]
     Reconstruct(#[from] crate::cloud::ReconstructError),
     /// The spline could not be built (degree out of range, bad knots).
+    ///
+    /// ```
+    /// use geofit::fit::{least_squares_curve, FitError};
+    /// use geofit::geom::Point3;
+    /// use geofit::spline::BSplineCurve;
+    /// let c = BSplineCurve::try_new(1, vec![0.0, 0.0, 1.0, 1.0], vec![Point3::ZERO, Point3::X]);
+    /// let line = c.unwrap();
+    /// let err = least_squares_curve(&line, &[Point3::ZERO], &[0.0, 1.0]).err();
+    /// assert!(matches!(err, Some(FitError::InvalidOption { name: "params", .. })));
+    /// let e: FitError = geofit::spline::SplineError::NonFiniteKnot { index: 0 }.into();
+    /// assert!(matches!(e, FitError::Spline(_)));
+    /// ```
     #[error(transparent)]
     Spline(#[from] crate::spline::SplineError),
     /// A least-squares system has no unique solution: some control point has no data nearby.
+    ///
+    /// ```
+    /// use geofit::fit::FitError;
+    /// let e = FitError::Singular { index: 4 };
+    /// assert_eq!(e.to_string(), "the least-squares system is singular at control point 4");
+    /// ```
     #[error("the least-squares system is singular at control point {index}")]
     Singular {
         /// The control point without support.
         index: usize,
     },
     /// The subdivision library rejected the control mesh or a refinement of it.
+    ///
+    /// ```
+    /// use geofit::fit::{surface_of, FitError};
+    /// use geofit::geom::Point3;
+    /// use geofit::mesh::PolyMesh;
+    /// use geofit::subdiv::Scheme;
+    /// let quad = PolyMesh::try_new(
+    ///     vec![Point3::ZERO, Point3::X, Point3::ONE, Point3::Y],
+    ///     vec![vec![0u32, 1, 2, 3]],
+    /// )
+    /// .unwrap();
+    /// let err = surface_of(Scheme::Loop, &quad).err();
+    /// assert!(matches!(err, Some(FitError::Subdiv(_))), "{err:?}");
+    /// ```
     #[error(transparent)]
     Subdiv(#[from] crate::subdiv::SubdivError),
     /// Projecting the points to parameterise them gives no usable parameter domain.
+    ///
+    /// ```
+    /// use geofit::fit::{FitError, LsqSurfaceFitter, LsqSurfaceOptions};
+    /// use geofit::geom::Point3;
+    /// let line: Vec<Point3> = (0..50).map(|i| Point3::new(i as f64, 0.0, 0.0)).collect();
+    /// let err = LsqSurfaceFitter::try_new(&line, LsqSurfaceOptions::default()).err();
+    /// assert!(matches!(err, Some(FitError::DegenerateProjection { .. })), "{err:?}");
+    /// ```
     #[error("cannot parameterise the points: {reason}")]
     DegenerateProjection {
         /// What is degenerate, with the view direction.
@@ -132,6 +225,12 @@ pub enum FitError {
     },
     /// The projection used for the parameters is not one-to-one: some points lie on a
     /// fold-over (their projections coincide with other points' at a clearly different depth).
+    ///
+    /// ```
+    /// use geofit::fit::FitError;
+    /// let e = FitError::FoldedProjection { count: 3, total: 100, first: 17 };
+    /// assert!(e.to_string().starts_with("the projection is not one-to-one: 3 of 100 points"));
+    /// ```
     #[error(
         "the projection is not one-to-one: {count} of {total} points lie on a fold-over \
          (first: point {first}); choose another view direction or a base surface, or exclude \
@@ -146,12 +245,24 @@ pub enum FitError {
         first: usize,
     },
     /// The linear solver failed (the system is singular: raise the smoothing weights).
+    ///
+    /// ```
+    /// use geofit::fit::FitError;
+    /// let e = FitError::Solver { reason: "not positive definite".into() };
+    /// assert!(e.to_string().ends_with("not positive definite"));
+    /// ```
     #[error("the least-squares system cannot be solved: {reason}")]
     Solver {
         /// The solver's message.
         reason: String,
     },
     /// An internal consistency check failed: a bug, not a problem of the input.
+    ///
+    /// ```
+    /// use geofit::fit::FitError;
+    /// let e = FitError::Internal { what: "a check".into() };
+    /// assert_eq!(e.to_string(), "internal error: a check");
+    /// ```
     #[error("internal error: {what}")]
     Internal {
         /// The check that failed.
