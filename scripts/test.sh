@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of geofit: formatting, clippy (native and wasm32), the native tests (unit,
-# integration, doc), the wasm build, the browser tests (tests/e2e/*.mjs in Debian chromium, both
+# integration, doc), the wasm build, the type check of the page's modules against the package's
+# declarations, the browser tests (tests/e2e/*.mjs in Debian chromium, both
 # WebGL2 and WebGPU) and the Python interop tests (tests/interop/*.py). Installs what it needs
 # first; fast when it is already installed. Prints how long each step took.
 set -euo pipefail
@@ -56,6 +57,7 @@ step "clippy native" cargo clippy --all-targets -- -D warnings
 step "clippy wasm32" cargo clippy --target wasm32-unknown-unknown --lib -- -D warnings
 step "cargo test --release" cargo test --release
 step "wasm build" bash scripts/build-wasm.sh
+step "typecheck www" node_modules/.bin/tsc -p tsconfig.json
 step "browser tests" run_e2e
 step "interop tests" run_interop
 

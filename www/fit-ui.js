@@ -148,7 +148,8 @@ class FitPanel {
     const u = this.ui;
     for (const dd of [u.iter, u.ctrl, u.eAvg, u.eMax, u.eRms, u.ms, u.total]) dd.textContent = '—';
     delete document.body.dataset.fitIter;
-    u.chart.getContext('2d', CHART_CONTEXT)?.clearRect(0, 0, u.chart.width, u.chart.height);
+    const g = /** @type {CanvasRenderingContext2D | null} */ (u.chart.getContext('2d', CHART_CONTEXT));
+    g?.clearRect(0, 0, u.chart.width, u.chart.height);
     this.go('idle');
   }
 

@@ -19,12 +19,14 @@ let resolution = LIMIT_RESOLUTION;
 /** @type {Fitter | null} */
 let fitter = null;
 let playing = false;
+/** The worker's postMessage (the DOM typings describe the window's). */
+const post = /** @type {(message: unknown, transfer?: Transferable[]) => void} */ (/** @type {unknown} */ (postMessage));
 let generation = 0;
 const ready = init();
 
 function fail(error, during) {
   playing = false;
-  postMessage({ type: MSG.error, during, generation, message: String(error?.message ?? error) });
+  post({ type: MSG.error, during, generation, message: String(error?.message ?? error) });
 }
 
 /**
@@ -62,7 +64,7 @@ function postFrame(f, kind) {
     frame.once = { data: f.dataPositions(), initial: { positions: initial.positions, edges: initial.edges } };
     initial.free();
   }
-  postMessage(frame, frameTransfers(frame));
+  post(frame, frameTransfers(frame));
 }
 
 /** Iterates slice by slice while playing, yielding to the message queue between slices. */
@@ -129,7 +131,7 @@ const handlers = {
     const make = EXPORTS[what];
     if (!make) throw new Error(`unknown export '${what}'`);
     const bytes = make(fitter);
-    postMessage({ type: MSG.exported, what, bytes }, [bytes.buffer]);
+    post({ type: MSG.exported, what, bytes }, [bytes.buffer]);
   },
 };
 

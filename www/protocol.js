@@ -52,7 +52,7 @@ export const MSG = Object.freeze({
 /**
  * The typed arrays of a frame, to transfer instead of copying.
  * @param {FrameMessage} frame
- * @returns {ArrayBufferLike[]}
+ * @returns {Transferable[]}
  */
 export function frameTransfers(frame) {
   const arrays = [
@@ -60,5 +60,5 @@ export function frameTransfers(frame) {
     frame.control.positions, frame.control.edges, frame.vectors, frame.iso,
   ];
   if (frame.once) arrays.push(frame.once.data, frame.once.initial.positions, frame.once.initial.edges);
-  return arrays.map((a) => a.buffer);
+  return arrays.map((a) => /** @type {ArrayBuffer} */ (a.buffer));
 }
