@@ -1,4 +1,4 @@
-//! Refinement against independent implementations: reference outputs made by libigl (Loop)
+//! Refinement against independent implementations: reference outputs made by MeshLab (Loop)
 //! and Blender/OpenSubdiv (Catmull–Clark) with `tests/data/subdiv/make_refs.py`, compared vertex
 //! by vertex after nearest-vertex matching.
 
@@ -68,7 +68,7 @@ fn check(input: &str, output: &str, scheme: Scheme, levels: usize, tol: f64) {
 }
 
 #[test]
-fn loop_matches_libigl_on_an_open_bunny_patch() {
+fn loop_matches_meshlab_on_an_open_bunny_patch() {
     check(
         "bunny_patch.obj",
         "bunny_patch_loop2.obj",
@@ -79,7 +79,7 @@ fn loop_matches_libigl_on_an_open_bunny_patch() {
 }
 
 #[test]
-fn loop_matches_libigl_on_a_closed_coarse_spot() {
+fn loop_matches_meshlab_on_a_closed_coarse_spot() {
     check(
         "spot_coarse.obj",
         "spot_coarse_loop2.obj",

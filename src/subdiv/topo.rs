@@ -431,13 +431,15 @@ pub(crate) struct Refined {
     pub topo: Topo,
 }
 
-/// Loop's vertex weight (Warren's form, as libigl uses): 3/16 for valence 3, else 3/(8n).
+/// Loop's vertex weight of a vertex with `n` neighbours, as Loop (1987) defines it and
+/// OpenSubdiv, MeshLab and the patent use it: β = (5/8 − (3/8 + ¼ cos 2π/n)²) / n. Warren's
+/// simpler 3/(8n) (libigl) agrees at valences 3 and 6 only, and an exported cage refined by
+/// another tool would give another surface elsewhere; so refinement, limit masks and exact
+/// evaluation all use this one.
 pub(crate) fn loop_beta(n: usize) -> f64 {
-    if n == 3 {
-        3.0 / 16.0
-    } else {
-        3.0 / (8.0 * n as f64)
-    }
+    let n = n as f64;
+    let c = 0.375 + 0.25 * (2.0 * std::f64::consts::PI / n).cos();
+    (0.625 - c * c) / n
 }
 
 pub(crate) fn key(a: u32, b: u32) -> (u32, u32) {
@@ -455,4 +457,18 @@ pub(crate) fn merge(mut s: Stencil) -> Stencil {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn loop_beta_is_loops() {
+        // Valence 6 is the regular 1/16 and valence 3 the 3/16 of Warren's form too; at other
+        // valences Loop's weight differs from Warren's 3/(8n).
+        assert!((super::loop_beta(6) - 1.0 / 16.0).abs() < 1e-15);
+        assert!((super::loop_beta(3) - 3.0 / 16.0).abs() < 1e-15);
+        let b4 = (0.625 - 0.375f64.powi(2)) / 4.0;
+        assert!((super::loop_beta(4) - b4).abs() < 1e-15);
+        assert!((super::loop_beta(4) - 3.0 / 32.0).abs() > 1e-3);
+    }
 }

@@ -1,16 +1,19 @@
 """Regenerates the subdivision reference data in this directory.
 
-Not run in CI. Run it with GEOFIT_REGEN_SUBDIV_REFS=1 after `pip install libigl pymeshlab bpy`:
+Not run in CI. Run it with GEOFIT_REGEN_SUBDIV_REFS=1 after `pip install pymeshlab bpy`:
 
-    GEOFIT_REGEN_SUBDIV_REFS=1 python3 tests/data/subdiv/make_refs.py
+    GEOFIT_REGEN_SUBDIV_REFS=1 python3 tests/data/subdiv/make_refs.py        # everything
+    GEOFIT_REGEN_SUBDIV_REFS=1 python3 tests/data/subdiv/make_refs.py loop   # the Loop outputs
 
 Inputs are small cut-outs / decimations of the shared scans (../shared/data):
 - bunny_patch.obj: 160 faces grown from one face of stanford-bunny.obj (open, with boundary);
 - spot_coarse.obj: spot.obj decimated by MeshLab's quadric edge collapse to 200 faces (closed);
 - spot_quads.obj, bunny_quads.obj: those with triangle pairs merged into quads where possible
   (quad-dominant: a few triangles remain).
-Outputs (Loop by libigl's igl.loop, Catmull–Clark by Blender's OpenSubdiv modifier):
-- *_loop2.obj: two Loop steps (libigl);
+Outputs (Loop by MeshLab's Loop subdivision with Loop's weights, Catmull–Clark by Blender's
+OpenSubdiv modifier):
+- *_loop2.obj: two Loop steps (pymeshlab `meshing_surface_subdivision_loop`, weights 'Loop',
+  threshold 0 so every edge is split; libigl's igl.loop uses Warren's simplified weights);
 - *_cc2.obj: two Catmull–Clark steps (Blender 5.0 subsurf = OpenSubdiv, boundary smooth 'ALL',
   no limit surface). Blender stores float32 coordinates, so these agree to about 1e-7 only.
 pymeshlab's "Catmull-Clark" was tried and is not the standard scheme (interior vertices differ
@@ -122,7 +125,6 @@ def quads_from_pairs(F):
 def main():
     if os.environ.get("GEOFIT_REGEN_SUBDIV_REFS") != "1":
         sys.exit("set GEOFIT_REGEN_SUBDIV_REFS=1 to regenerate the reference data")
-    import igl
     import pymeshlab
 
     V, F = read_obj(os.path.join(DATA, "stanford-bunny.obj"))
@@ -142,15 +144,26 @@ def main():
     write_obj(os.path.join(HERE, "spot_coarse.obj"), Vs, Fs)
     write_obj(os.path.join(HERE, "spot_quads.obj"), Vs, quads_from_pairs(Fs))
 
-    for name in ["bunny_patch", "spot_coarse"]:
-        Vi, Fi = read_obj(os.path.join(HERE, name + ".obj"))
-        Vo, Fo = igl.loop(Vi, np.array(Fi, dtype=np.int64), 2)
-        write_obj(os.path.join(HERE, name + "_loop2.obj"), Vo, Fo.tolist())
+    make_loop_refs()
 
     try:
         make_cc_refs()
     except ImportError:
         print("bpy not installed: Catmull–Clark references not regenerated")
+
+
+def make_loop_refs():
+    import pymeshlab
+
+    for name in ["bunny_patch", "spot_coarse"]:
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(os.path.join(HERE, name + ".obj"))
+        ms.meshing_surface_subdivision_loop(
+            loopweight="Loop", iterations=2, threshold=pymeshlab.PercentageValue(0)
+        )
+        m = ms.current_mesh()
+        Fo = [list(map(int, f)) for f in m.face_matrix()]
+        write_obj(os.path.join(HERE, name + "_loop2.obj"), m.vertex_matrix(), Fo)
 
 
 def make_cc_refs():
@@ -180,4 +193,9 @@ def make_cc_refs():
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["loop"]:
+        if os.environ.get("GEOFIT_REGEN_SUBDIV_REFS") != "1":
+            sys.exit("set GEOFIT_REGEN_SUBDIV_REFS=1 to regenerate the reference data")
+        make_loop_refs()
+    else:
+        main()
