@@ -1,6 +1,7 @@
 //! The bookkeeping every engine shares: one record per iteration, the status, the set-up time
 //! and what happened to the data on intake.
 
+use super::reference::BackStats;
 use super::{ErrorStats, FitStatus, IterationRecord, ReconstructionReport};
 use web_time::Instant;
 
@@ -35,6 +36,7 @@ impl FitLog {
         start: Instant,
         control_points: usize,
         stats: &ErrorStats,
+        back: Option<BackStats>,
         refined: bool,
         status: FitStatus,
     ) -> FitStatus {
@@ -48,6 +50,8 @@ impl FitLog {
             e_rms_pct: stats.e_rms_pct,
             ms: seconds * 1e3,
             refined,
+            e_back_max_pct: back.map(|b| b.max_pct),
+            e_back_p99_pct: back.map(|b| b.p99_pct),
         });
         self.status = status;
         status

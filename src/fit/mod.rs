@@ -18,6 +18,7 @@ mod curve;
 mod error;
 mod log;
 mod parallel;
+mod reference;
 mod report;
 mod spec;
 mod state;
@@ -32,9 +33,10 @@ pub use curve::{
 };
 pub use error::FitError;
 pub use log::FitLog;
+pub use reference::{BackStats, DataSurface};
 pub use report::{within_tolerance_pct, FitReport};
 pub use spec::{Cloud, FitData, FitSpec, Method, OptionInfo, Scheme, OPTION_TABLE};
-pub use state::FitState;
+pub use state::{FitState, BACK_TOLERANCE_FACTOR};
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
 pub use subdiv::{
     default_initial_count, initial_control, surface_of, ControlSurface, ReconstructionReport,
@@ -173,6 +175,11 @@ pub trait Fitter {
     /// Error statistics of the current surface or curve.
     fn stats(&self) -> ErrorStats {
         self.state().stats()
+    }
+
+    /// Surface → data statistics of the current surface, where the fit measures them.
+    fn back_stats(&self) -> Option<BackStats> {
+        self.state().back()
     }
 
     /// The point of the surface or curve each data point is measured to, in data order.

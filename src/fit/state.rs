@@ -3,8 +3,10 @@
 //! [`FitLog`]. [`Fitter`](super::Fitter) reads all of it from here, so an engine implements
 //! only its iteration and its shapes.
 
+use super::reference::{BackStats, DataSurface};
 use super::{ErrorStats, FitLog, Method, Scheme, Tolerances};
 use crate::geom::{Aabb, Point3};
+use std::sync::Arc;
 use web_time::Instant;
 
 /// The shared state of a fit.
@@ -18,7 +20,13 @@ pub struct FitState {
     errors: Vec<f64>,
     stats: ErrorStats,
     log: FitLog,
+    reference: Option<Arc<DataSurface>>,
+    back: Option<BackStats>,
 }
+
+/// A fit has converged only while no sample of its surface lies farther from the data than
+/// this many E_max tolerances (SPEC §6: sheets or spikes away from the data are not a fit).
+pub const BACK_TOLERANCE_FACTOR: f64 = 2.0;
 
 impl FitState {
     /// The state of a fit of `data` (finite points) that starts with `initial_control`
@@ -40,7 +48,32 @@ impl FitState {
             diagonal: if diagonal > 0.0 { diagonal } else { 1.0 },
             stats: ErrorStats::default(),
             log: FitLog::new(initial_control, start),
+            reference: None,
+            back: None,
         }
+    }
+
+    /// Measures the surface → data distance against `reference` from now on.
+    pub(crate) fn set_reference(&mut self, reference: Option<DataSurface>) {
+        self.reference = reference.map(Arc::new);
+    }
+
+    /// Whether the surface → data distance is measured.
+    pub(crate) fn has_reference(&self) -> bool {
+        self.reference.is_some()
+    }
+
+    /// Measures the surface → data distances of `samples` of the current surface.
+    pub(crate) fn measure_back(&mut self, samples: &[Point3]) {
+        self.back = self
+            .reference
+            .as_ref()
+            .map(|r| r.measure(samples, self.diagonal));
+    }
+
+    /// The last surface → data statistics, when they are measured.
+    pub fn back(&self) -> Option<BackStats> {
+        self.back
     }
 
     /// The scheme fitted.
@@ -89,9 +122,14 @@ impl FitState {
         &mut self.log
     }
 
-    /// Whether the statistics meet every tolerance.
+    /// Whether the statistics meet every tolerance, and no surface sample lies farther from the
+    /// data than [`BACK_TOLERANCE_FACTOR`] E_max tolerances.
     pub(crate) fn met(&self) -> bool {
-        self.tolerances.met_by(&self.stats)
+        let back_ok = match (self.back, self.tolerances.max_pct) {
+            (Some(b), Some(tol)) => b.max_pct <= BACK_TOLERANCE_FACTOR * tol,
+            _ => true,
+        };
+        self.tolerances.met_by(&self.stats) && back_ok
     }
 
     /// The data points and the errors to overwrite, at once; call
@@ -137,7 +175,13 @@ impl FitState {
         refined: bool,
         status: super::FitStatus,
     ) -> super::FitStatus {
-        self.log
-            .record(start, control_points, &self.stats, refined, status)
+        self.log.record(
+            start,
+            control_points,
+            &self.stats,
+            self.back,
+            refined,
+            status,
+        )
     }
 }

@@ -150,6 +150,13 @@ pub struct IterationRecord {
     pub ms: f64,
     /// Whether the control mesh was refined (or knots inserted) in this iteration.
     pub refined: bool,
+    /// Surface → data: the largest distance of a sample of the surface to the data, % (absent
+    /// where the fit measures none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub e_back_max_pct: Option<f64>,
+    /// Surface → data: the 99th-percentile distance, %.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub e_back_p99_pct: Option<f64>,
 }
 
 #[cfg(test)]

@@ -354,16 +354,21 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
         let before = fitter.history().len();
         let status = fitter.step().map_err(|e| e.to_string())?;
         match fitter.history().last() {
-            Some(r) if !args.quiet && fitter.history().len() > before => outln!(
-                "iter {:>3}  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%  {:7.1} ms{}",
+            Some(r) if !args.quiet && fitter.history().len() > before => {
+                outln!(
+                "iter {:>3}  ctrl {:>6}  E_avg {:.5}%  E_max {:.5}%  E_rms {:.5}%{}  {:7.1} ms{}",
                 r.iter,
                 r.control_points,
                 r.e_avg_pct,
                 r.e_max_pct,
                 r.e_rms_pct,
+                r.e_back_max_pct.zip(r.e_back_p99_pct).map_or(String::new(), |(b, p)| {
+                    format!("  E_back {b:.4}% (p99 {p:.4}%)")
+                }),
                 r.ms,
                 if r.refined { "  refined" } else { "" }
-            ),
+            )
+            }
             _ => {}
         }
         if status != FitStatus::Running {

@@ -1,9 +1,87 @@
 //! The surface as a linear map of the control points at frozen foot parameters:
 //! S(t_i) = Σ_j B_j(t_i) P_j with the limit stencils cached, and conjugate gradients on the
-//! least-squares problem min Σ_i ‖p_i − S(t_i)‖² over control-point moves.
+//! least-squares problem min Σ_i ‖p_i − S(t_i)‖² over control-point moves, with a fairness term
+//! on the control net that holds the control points few data points pull on.
 
-use crate::geom::Vec3;
+use crate::geom::{Point3, Vec3};
+use crate::mesh::PolyMesh;
 use crate::subdiv::{LimitSurface, SurfaceParam};
+
+/// The umbrella fairness of a control net, E = w Σ_j ‖P_j − mean of P_j's neighbours‖²: zero on
+/// an evenly spaced flat net, small on a smooth one, large at a spike. Added to the fit's
+/// least-squares problem with a weight `w` that is a small fraction of a typical control
+/// point's data support, it barely moves a control point that many data points hold, and holds
+/// one that few or none do — without it such points take the huge steps of an ill-conditioned
+/// problem and the surface grows sheets and spikes away from the data.
+pub(crate) struct Fairness {
+    starts: Vec<usize>,
+    neighbours: Vec<u32>,
+}
+
+impl Fairness {
+    /// The neighbours (edge-connected vertices) of every control point of `control`.
+    pub(crate) fn of(control: &PolyMesh) -> Fairness {
+        let n = control.num_vertices();
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for f in control.faces() {
+            for k in 0..f.len() {
+                let (a, b) = (f[k], f[(k + 1) % f.len()]);
+                pairs.push((a, b));
+                pairs.push((b, a));
+            }
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut starts = vec![0usize; n + 1];
+        for &(a, _) in &pairs {
+            starts[a as usize + 1] += 1;
+        }
+        for j in 0..n {
+            starts[j + 1] += starts[j];
+        }
+        Fairness {
+            starts,
+            neighbours: pairs.into_iter().map(|(_, b)| b).collect(),
+        }
+    }
+
+    fn ring(&self, j: usize) -> &[u32] {
+        self.starts
+            .get(j..j + 2)
+            .map_or(&[][..], |s| &self.neighbours[s[0]..s[1]])
+    }
+
+    /// (U x)_j = x_j − mean of x over j's neighbours (0 for a point without neighbours).
+    fn umbrella(&self, x: &[Vec3]) -> Vec<Vec3> {
+        (0..x.len())
+            .map(|j| {
+                let ring = self.ring(j);
+                if ring.is_empty() {
+                    return Vec3::ZERO;
+                }
+                let mean: Vec3 =
+                    ring.iter().map(|&k| x[k as usize]).sum::<Vec3>() / ring.len() as f64;
+                x[j] - mean
+            })
+            .collect()
+    }
+
+    /// out += w Uᵀ U x.
+    fn add_normal(&self, x: &[Vec3], w: f64, out: &mut [Vec3]) {
+        let u = self.umbrella(x);
+        for (j, uj) in u.iter().enumerate() {
+            let ring = self.ring(j);
+            if ring.is_empty() {
+                continue;
+            }
+            out[j] += *uj * w;
+            let share = *uj * (w / ring.len() as f64);
+            for &k in ring {
+                out[k as usize] -= share;
+            }
+        }
+    }
+}
 
 /// Limit stencils of a set of parameters, in compressed rows (one row per data point).
 pub(crate) struct Stencils {
@@ -79,13 +157,16 @@ impl Stencils {
     /// full weight on the distance along the normal n_i, weight `w` = `tangent_weight` on the
     /// tangential slip that frozen parameters create as the surface moves (w = 1 is the plain
     /// point-to-point problem; smaller w converges faster, as in squared-distance minimisation).
-    /// Returns the control-point moves Δ; control points no data point depends on stay put.
+    /// With `fair = Some((fairness, points, λ))` the problem gains the umbrella fairness of the
+    /// control net at `points + Δ`, weighted λ times the median data support of a control point
+    /// (Σ_i B_ij² over the data). Returns the control-point moves Δ.
     pub(crate) fn cg(
         &self,
         e: &[Vec3],
         normals: &[Vec3],
         tangent_weight: f64,
         steps: usize,
+        fair: Option<(&Fairness, &[Point3], f64)>,
     ) -> Vec<Vec3> {
         let n = self.columns;
         let metric = |i: usize, v: Vec3| {
@@ -96,6 +177,10 @@ impl Stencils {
         let mut diag = vec![0.0; n];
         for &(j, w) in &self.entries {
             diag[j as usize] += w * w;
+        }
+        let fair = fair.map(|(f, points, lambda)| (f, points, lambda * median(&diag)));
+        if let Some((_, _, w)) = fair {
+            diag.iter_mut().for_each(|d| *d += w);
         }
         let inv: Vec<f64> = diag
             .iter()
@@ -108,12 +193,24 @@ impl Stencils {
         let mut r = vec![Vec3::ZERO; n];
         let me: Vec<Vec3> = e.iter().enumerate().map(|(i, &v)| metric(i, v)).collect();
         self.apply_transposed(&me, &mut r);
+        if let Some((f, points, w)) = fair {
+            // The right-hand side's fairness part: −w Uᵀ U P.
+            let p: Vec<Vec3> = points.to_vec();
+            let mut up = vec![Vec3::ZERO; n];
+            f.add_normal(&p, w, &mut up);
+            for (rk, uk) in r.iter_mut().zip(&up) {
+                *rk -= *uk;
+            }
+        }
         let mut z = precondition(&r);
         let mut p = z.clone();
         let mut rz = dot(&r, &z);
         let mut ap = vec![Vec3::ZERO; n];
         for _ in 0..steps {
             self.apply_normal(&p, metric, &mut ap);
+            if let Some((f, _, w)) = fair {
+                f.add_normal(&p, w, &mut ap);
+            }
             let pap = dot(&p, &ap);
             let alpha = rz / pap;
             if !(pap > 0.0 && alpha.is_finite()) {
@@ -136,4 +233,15 @@ impl Stencils {
         }
         x
     }
+}
+
+/// The median of `values` (0 for none).
+fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut v = values.to_vec();
+    let mid = v.len() / 2;
+    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
+    *m
 }

@@ -13,11 +13,13 @@ pub(crate) use setup::build_subdiv_fitter;
 pub use setup::{default_initial_count, initial_control, ReconstructionReport};
 
 use super::accel::Accelerator;
-use super::{Acceleration, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme, Shape};
+use super::{
+    Acceleration, DataSurface, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme, Shape,
+};
 use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
-use crate::subdiv::{tessellate, LimitSurface, SurfaceParam};
-use frozen::Stencils;
+use crate::subdiv::{tessellate, LimitSurface, PatchDomain, SurfaceParam};
+use frozen::{Fairness, Stencils};
 use index::SurfaceIndex;
 use std::collections::HashSet;
 use web_time::Instant;
@@ -128,6 +130,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
             scratch: Vec::new(),
         };
         fitter.search_all_feet()?;
+        fitter.measure_back();
         let n = fitter.log().initial_control_points();
         *fitter.state.log_mut() = FitLog::new(n, start);
         Ok(fitter)
@@ -277,11 +280,17 @@ impl<S: ControlSurface> SubdivFitter<S> {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
                 let normals: Vec<Vec3> = self.feet.iter().map(|f| f.direction).collect();
+                let fairness = (self.options.fairness > 0.0)
+                    .then(|| Fairness::of(&self.surface.control_polygons()));
+                let fair = fairness
+                    .as_ref()
+                    .map(|f| (f, old_points.as_slice(), self.options.fairness));
                 stencils.cg(
                     &self.error_vectors(),
                     &normals,
                     self.options.tangent_weight,
                     inner,
+                    fair,
                 )
             }
             _ => self.moves(),
@@ -466,6 +475,32 @@ impl<S: ControlSurface> SubdivFitter<S> {
         Ok(())
     }
 
+    /// Measures how far the limit surface strays from the data (when a reference is set): at
+    /// every patch's centre, where a sheet between control points bulges most, and at its first
+    /// corner (a control vertex for Loop and Catmull–Clark), where a spike at a control point
+    /// shows.
+    fn measure_back(&mut self) {
+        if !self.state.has_reference() {
+            return;
+        }
+        let centre = match self.surface.domain() {
+            PatchDomain::Triangle => 1.0 / 3.0,
+            PatchDomain::Square => 0.5,
+        };
+        let samples: Vec<Point3> = (0..self.surface.num_patches() as u32)
+            .flat_map(|patch| [(centre, centre), (0.0, 0.0)].map(|(u, v)| (patch, u, v)))
+            .map(|(patch, u, v)| self.surface.eval(SurfaceParam { patch, u, v }).point)
+            .collect();
+        self.state.measure_back(&samples);
+    }
+
+    /// Measures the surface → data distance against `reference` (the data's triangles).
+    pub fn with_reference(mut self, reference: Option<DataSurface>) -> Self {
+        self.state.set_reference(reference);
+        self.measure_back();
+        self
+    }
+
     fn due_for_refinement(&self, improvement: f64) -> bool {
         self.options.refine
             && self.num_control_points() < self.budget()
@@ -485,6 +520,7 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         let start = Instant::now();
         let before = self.state.stats().e_rms;
         let moved = self.move_control_points();
+        self.measure_back();
         self.since_refine += 1;
         let improvement = if before > 0.0 && moved {
             (before - self.state.stats().e_rms) / before
@@ -496,6 +532,7 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
             refined = self.refine()?;
             if refined {
                 self.since_refine = 0;
+                self.measure_back();
             }
         }
         let status = self

@@ -61,6 +61,10 @@ pub struct SubdivFitOptions {
     /// With CG acceleration: weight of the tangential part of the error vectors relative to the
     /// normal part (1 = point-to-point distance, smaller = closer to point-to-plane) [0.1].
     pub tangent_weight: f64,
+    /// With CG acceleration: weight of the control net's umbrella fairness, relative to the
+    /// median data support of a control point; it holds the control points that few data points
+    /// pull on (0: none) [0.01].
+    pub fairness: f64,
 }
 
 impl SubdivFitOptions {
@@ -84,6 +88,7 @@ impl SubdivFitOptions {
         },
         index_resolution: 4,
         tangent_weight: 0.1,
+        fairness: 0.01,
     };
 
     /// The acceleration that goes with a weighting when none is chosen: CG solves the
@@ -140,6 +145,12 @@ impl SubdivFitOptions {
                 format!("{} is not in (0, 1]", self.tangent_weight),
             );
         }
+        if !(self.fairness.is_finite() && self.fairness >= 0.0) {
+            return bad(
+                "fairness",
+                format!("{} is not a finite weight >= 0", self.fairness),
+            );
+        }
         if !(1..=32).contains(&self.index_resolution) {
             return bad(
                 "index_resolution",
@@ -179,4 +190,6 @@ setters!(SubdivFitOptions {
     with_tangent_weight(tangent_weight: f64) => |s| s.tangent_weight;
     /// Turns the remeshing flips on or off.
     with_remesh(remesh: bool) => |s| s.remesh;
+    /// Sets the weight of the control net's fairness.
+    with_fairness(fairness: f64) => |s| s.fairness;
 });

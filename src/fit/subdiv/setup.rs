@@ -3,7 +3,7 @@
 
 use super::{SubdivFitOptions, SubdivFitter};
 use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
-use crate::fit::{FitError, Fitter};
+use crate::fit::{DataSurface, FitError, Fitter};
 use crate::geom::Point3;
 use crate::io::RangeGrid;
 use crate::mesh::PolyMesh;
@@ -71,14 +71,16 @@ pub(crate) fn build_subdiv_fitter(
             Some(mesh) => mesh.clone(),
             None => initial_control(data, initial)?,
         };
-        return SubdivFitter::try_new(data.positions(), control, scheme, options);
+        let fitter = SubdivFitter::try_new(data.positions(), control, scheme, options)?;
+        return Ok(fitter.with_reference(DataSurface::of_mesh(data)));
     }
     let (points, mesh, report) = reconstruct_cloud(data.positions(), grid, cloud)?;
     let control = match control {
         Some(mesh) => mesh.clone(),
         None => initial_control(&mesh, initial)?,
     };
-    let mut fitter = SubdivFitter::try_new(&points, control, scheme, options)?;
+    let mut fitter = SubdivFitter::try_new(&points, control, scheme, options)?
+        .with_reference(DataSurface::of_mesh(&mesh));
     fitter.log_mut().set_reconstruction(Some(report));
     Ok(fitter)
 }

@@ -1,0 +1,410 @@
+//! The data as a surface, to measure the fit the other way round: how far the fitted surface
+//! strays from the data (surface → data, "E_back"). E_avg and E_max only say how close the data
+//! is to the surface; a surface can hold every data point and still have sheets and spikes where
+//! no data point pulls on it (SPEC §6). This module measures those.
+//!
+//! The data surface is the data's triangles (the input mesh, or the mesh reconstructed from
+//! bare points), in an R-tree (`rstar`) whose nearest-neighbour query is exact. A sample whose
+//! nearest data point lies on a boundary edge of the data, or whose nearest boundary point is
+//! hardly farther than its nearest data point ([`RIM_FACTOR`]), spans a hole or lies beyond the
+//! data's outline — a surface may span holes (SPEC §6) — and is left out of the statistics. On a
+//! closed mesh nothing is left out.
+
+use crate::geom::Point3;
+use crate::mesh::PolyMesh;
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
+use rstar::{PointDistance, RTree, RTreeObject, AABB};
+use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+
+/// A sample whose nearest point on the data's boundary (the rim of a hole, the outline) is at
+/// most this many times as far as its nearest data point spans a hole: a surface sagging across
+/// a hole can come nearer to the data beyond the rim than to the rim itself, but not by much.
+pub const RIM_FACTOR: f64 = 2.0;
+
+/// The surface → data distances of one fitted surface: their largest and 99th-percentile values
+/// in % of the data's bounding-box diagonal, over the samples that lie over data.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BackStats {
+    /// Largest distance of a surface sample to the data, % of the diagonal.
+    pub max_pct: f64,
+    /// 99th percentile of those distances, %.
+    pub p99_pct: f64,
+    /// Samples measured.
+    pub samples: usize,
+    /// Samples left out as spanning a hole of the data or lying beyond its outline.
+    pub over_holes: usize,
+}
+
+/// One data triangle in the R-tree: its corners (f32, compact storage) and which of its edges
+/// and corners lie on the data's boundary (bit k: edge from corner k to corner k + 1; bit 3 + k:
+/// corner k).
+struct Triangle {
+    corners: [[f32; 3]; 3],
+    boundary: u8,
+}
+
+impl Triangle {
+    fn points(&self) -> [Point3; 3] {
+        self.corners
+            .map(|[x, y, z]| Point3::new(x as f64, y as f64, z as f64))
+    }
+}
+
+impl RTreeObject for Triangle {
+    type Envelope = AABB<[f64; 3]>;
+
+    fn envelope(&self) -> Self::Envelope {
+        let [a, b, c] = self.points();
+        AABB::from_corners(a.min(b).min(c).to_array(), a.max(b).max(c).to_array())
+    }
+}
+
+impl PointDistance for Triangle {
+    fn distance_2(&self, p: &[f64; 3]) -> f64 {
+        let [a, b, c] = self.points();
+        let p = Point3::from_array(*p);
+        (p - closest_on_triangle(p, a, b, c).0).length_squared()
+    }
+}
+
+/// A boundary edge of the data, for the distance to the data's rim.
+struct Rim([[f64; 3]; 2]);
+
+impl RTreeObject for Rim {
+    type Envelope = AABB<[f64; 3]>;
+
+    fn envelope(&self) -> Self::Envelope {
+        let [a, b] = self.0.map(Point3::from_array);
+        AABB::from_corners(a.min(b).to_array(), a.max(b).to_array())
+    }
+}
+
+impl PointDistance for Rim {
+    fn distance_2(&self, p: &[f64; 3]) -> f64 {
+        let [a, b] = self.0.map(Point3::from_array);
+        let p = Point3::from_array(*p);
+        let ab = b - a;
+        let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+        (p - (a + ab * t)).length_squared()
+    }
+}
+
+/// The data's triangles, indexed for nearest-point queries.
+pub struct DataSurface {
+    tree: RTree<Triangle>,
+    /// The boundary edges (none on a closed mesh).
+    rim: RTree<Rim>,
+    /// The data points in no triangle (a scanner's points in a hole of the mesh, say): the
+    /// surface may pass between them. Each stands for a disc of surface as wide as the distance
+    /// to its nearest other point (`loose_spacing`), so a sample's distance to one is counted
+    /// less that spacing.
+    loose: Option<ImmutableKdTree<f32, u32, 3, 32>>,
+    loose_spacing: Vec<f32>,
+}
+
+impl std::fmt::Debug for DataSurface {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DataSurface")
+            .field("triangles", &self.tree.size())
+            .field("loose points", &self.loose.as_ref().map_or(0, |t| t.size()))
+            .finish()
+    }
+}
+
+/// Where on the data surface a query landed.
+struct Foot {
+    dist_sq: f64,
+    on_boundary: bool,
+}
+
+impl DataSurface {
+    /// The surface of `mesh`'s faces (polygons fanned into triangles); `None` without faces.
+    pub fn of_mesh(mesh: &PolyMesh) -> Option<DataSurface> {
+        let triangles = mesh.triangles();
+        if triangles.is_empty() {
+            return None;
+        }
+        let positions: Vec<[f32; 3]> = mesh
+            .positions()
+            .iter()
+            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect();
+        let boundary = boundary_edges(&triangles);
+        let mut on_boundary = vec![false; positions.len()];
+        for (t, &b) in triangles.iter().zip(&boundary) {
+            for k in 0..3 {
+                if b & (1 << k) != 0 {
+                    on_boundary[t[k] as usize] = true;
+                    on_boundary[t[(k + 1) % 3] as usize] = true;
+                }
+            }
+        }
+        let mut rim = Vec::new();
+        for (t, &b) in triangles.iter().zip(&boundary) {
+            for k in 0..3 {
+                if b & (1 << k) != 0 {
+                    let at = |i: u32| mesh.positions()[i as usize].to_array();
+                    rim.push(Rim([at(t[k]), at(t[(k + 1) % 3])]));
+                }
+            }
+        }
+        let objects = triangles
+            .iter()
+            .zip(&boundary)
+            .map(|(t, &b)| Triangle {
+                corners: t.map(|i| positions[i as usize]),
+                boundary: (0..3).fold(b, |m, k| {
+                    m | (u8::from(on_boundary[t[k] as usize]) << (3 + k))
+                }),
+            })
+            .collect();
+        let mut used = vec![false; positions.len()];
+        for t in &triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        let loose: Vec<[f32; 3]> = positions
+            .iter()
+            .zip(&used)
+            .filter(|(_, &u)| !u)
+            .map(|(p, _)| *p)
+            .collect();
+        let all: ImmutableKdTree<f32, u32, 3, 32> = ImmutableKdTree::new_from_slice(&positions);
+        let two = std::num::NonZero::<usize>::new(2).unwrap_or(std::num::NonZero::<usize>::MIN);
+        let loose_spacing = loose
+            .iter()
+            .map(|q| {
+                let near = all.nearest_n::<SquaredEuclidean>(q, two);
+                near.last().map_or(0.0, |n| n.distance.sqrt())
+            })
+            .collect();
+        Some(DataSurface {
+            tree: RTree::bulk_load(objects),
+            rim: RTree::bulk_load(rim),
+            loose: (!loose.is_empty()).then(|| ImmutableKdTree::new_from_slice(&loose)),
+            loose_spacing,
+        })
+    }
+
+    /// The distance from `p` to the data surface, or `None` when `p`'s nearest data point is on
+    /// the data's boundary (over a hole, or beyond the outline).
+    pub fn distance(&self, p: Point3) -> Option<f64> {
+        let foot = self.nearest(p)?;
+        let loose = self.loose.as_ref().map_or(f64::INFINITY, |t| {
+            let q = [p.x as f32, p.y as f32, p.z as f32];
+            let n = t.nearest_one::<SquaredEuclidean>(&q);
+            let spacing = self
+                .loose_spacing
+                .get(n.item as usize)
+                .copied()
+                .unwrap_or(0.0);
+            ((n.distance as f64).sqrt() - spacing as f64).max(0.0)
+        });
+        if loose * loose < foot.dist_sq {
+            return Some(loose);
+        }
+        if foot.on_boundary {
+            return None;
+        }
+        let rim = self
+            .rim
+            .nearest_neighbor(&p.to_array())
+            .map_or(f64::INFINITY, |r| r.distance_2(&p.to_array()));
+        (rim > RIM_FACTOR * RIM_FACTOR * foot.dist_sq).then(|| foot.dist_sq.sqrt())
+    }
+
+    /// The surface → data statistics of `samples` (points of a fitted surface), relative to a
+    /// bounding-box `diagonal`.
+    pub fn measure(&self, samples: &[Point3], diagonal: f64) -> BackStats {
+        let mut d: Vec<f64> = samples.iter().filter_map(|&p| self.distance(p)).collect();
+        let over_holes = samples.len() - d.len();
+        if d.is_empty() {
+            return BackStats {
+                over_holes,
+                ..BackStats::default()
+            };
+        }
+        let pct = if diagonal > 0.0 {
+            100.0 / diagonal
+        } else {
+            0.0
+        };
+        let k = ((d.len() as f64 * 0.99).ceil() as usize).clamp(1, d.len()) - 1;
+        let (_, p99, _) = d.select_nth_unstable_by(k, f64::total_cmp);
+        let p99 = *p99;
+        let max = d.iter().copied().fold(0.0f64, f64::max);
+        BackStats {
+            max_pct: max * pct,
+            p99_pct: p99 * pct,
+            samples: d.len(),
+            over_holes,
+        }
+    }
+
+    /// The nearest point of the data surface, and whether it lies on the data's boundary.
+    fn nearest(&self, p: Point3) -> Option<Foot> {
+        if !p.is_finite() {
+            return None;
+        }
+        let t = self.tree.nearest_neighbor(&p.to_array())?;
+        let [a, b, c] = t.points();
+        let (point, feature) = closest_on_triangle(p, a, b, c);
+        let mask = t.boundary;
+        let on_boundary = match feature {
+            Feature::Face => false,
+            Feature::Edge(k) => mask & (1 << k) != 0,
+            Feature::Vertex(k) => mask & (1 << (3 + k)) != 0,
+        };
+        Some(Foot {
+            dist_sq: (p - point).length_squared(),
+            on_boundary,
+        })
+    }
+}
+
+/// Which part of a triangle a closest point lies on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Feature {
+    Face,
+    /// Edge from corner k to corner k + 1.
+    Edge(usize),
+    /// Corner k.
+    Vertex(usize),
+}
+
+/// The closest point of triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5), and
+/// the feature it lies on.
+fn closest_on_triangle(p: Point3, a: Point3, b: Point3, c: Point3) -> (Point3, Feature) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, Feature::Vertex(0));
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, Feature::Vertex(1));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, Feature::Vertex(2));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + (c - b) * w, Feature::Edge(1));
+    }
+    let denom = va + vb + vc;
+    if !(denom.abs() > f64::MIN_POSITIVE) {
+        // A degenerate (zero-area) triangle: its nearest corner.
+        let best = [a, b, c]
+            .into_iter()
+            .enumerate()
+            .min_by(|x, y| {
+                (p - x.1)
+                    .length_squared()
+                    .total_cmp(&(p - y.1).length_squared())
+            })
+            .map_or(0, |(k, _)| k);
+        return ([a, b, c][best], Feature::Vertex(best));
+    }
+    let (v, w) = (vb / denom, vc / denom);
+    (a + ab * v + ac * w, Feature::Face)
+}
+
+/// Per triangle, the bit mask of its edges that no other triangle shares.
+fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<u8> {
+    let mut count: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 2);
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    for t in triangles {
+        for k in 0..3 {
+            *count.entry(key(t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    triangles
+        .iter()
+        .map(|t| {
+            (0..3).fold(0u8, |m, k| {
+                let open = count.get(&key(t[k], t[(k + 1) % 3])) == Some(&1);
+                m | (u8::from(open) << k)
+            })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Vec3;
+
+    /// A unit square in z = 0 made of two triangles (open: four boundary edges).
+    fn square() -> PolyMesh {
+        let p = vec![
+            Point3::ZERO,
+            Point3::X,
+            Point3::new(1.0, 1.0, 0.0),
+            Point3::Y,
+        ];
+        PolyMesh::try_new(p, vec![[0u32, 1, 2], [0, 2, 3]]).expect("valid")
+    }
+
+    #[test]
+    fn distances_above_the_data_and_beyond_its_outline() {
+        let s = DataSurface::of_mesh(&square()).expect("faces");
+        let above = Point3::new(0.3, 0.6, 0.0) + Vec3::Z * 0.25;
+        assert!((s.distance(above).expect("over data") - 0.25).abs() < 1e-6);
+        // Beyond the outline the nearest point is on a boundary edge: left out.
+        assert_eq!(s.distance(Point3::new(2.0, 0.5, 0.1)), None);
+        assert_eq!(s.distance(Point3::new(-1.0, -1.0, 0.0)), None);
+    }
+
+    #[test]
+    fn statistics_of_a_bulge() {
+        let s = DataSurface::of_mesh(&square()).expect("faces");
+        // 99 samples on the data, one 0.5 above it: max 0.5, p99 0.
+        let mut samples: Vec<Point3> = (0..99)
+            .map(|i| Point3::new(0.1 + 0.008 * i as f64, 0.5, 0.0))
+            .collect();
+        samples.push(Point3::new(0.5, 0.5, 0.5));
+        let b = s.measure(&samples, 2.0);
+        assert!((b.max_pct - 25.0).abs() < 1e-4, "{b:?}");
+        assert!(b.p99_pct < 1e-4, "{b:?}");
+        assert_eq!((b.samples, b.over_holes), (100, 0));
+    }
+
+    #[test]
+    fn closest_point_features() {
+        let (a, b, c) = (Point3::ZERO, Point3::X, Point3::Y);
+        assert_eq!(
+            closest_on_triangle(Point3::new(-1.0, -1.0, 0.0), a, b, c).1,
+            Feature::Vertex(0)
+        );
+        assert_eq!(
+            closest_on_triangle(Point3::new(0.5, -1.0, 0.0), a, b, c).1,
+            Feature::Edge(0)
+        );
+        assert_eq!(
+            closest_on_triangle(Point3::new(1.0, 1.0, 0.0), a, b, c).1,
+            Feature::Edge(1)
+        );
+        assert_eq!(
+            closest_on_triangle(Point3::new(-1.0, 0.5, 0.0), a, b, c).1,
+            Feature::Edge(2)
+        );
+        let (p, f) = closest_on_triangle(Point3::new(0.2, 0.2, 3.0), a, b, c);
+        assert_eq!(f, Feature::Face);
+        assert!((p - Point3::new(0.2, 0.2, 0.0)).length() < 1e-15);
+    }
+}
