@@ -4,11 +4,13 @@
 mod error;
 mod halfedge;
 mod poly;
+pub mod repair;
 pub mod simplify;
 mod validate;
 
 pub use error::MeshError;
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
+pub use repair::{repair, repair_with, RepairOptions, RepairReport, Repaired};
 pub use simplify::{simplify, simplify_with, SimplifyError, SimplifyOptions};
 pub use validate::TopologyError;
