@@ -49,10 +49,22 @@ fn pyramid(pos: &mut Vec<Point3>, faces: &mut Vec<[u32; 3]>, apex: u32, dir: f64
     }
     for k in 0..4 {
         let (p, q) = (b + k, b + (k + 1) % 4);
-        faces.push(if dir > 0.0 { [apex, p, q] } else { [apex, q, p] });
+        faces.push(if dir > 0.0 {
+            [apex, p, q]
+        } else {
+            [apex, q, p]
+        });
     }
-    faces.push(if dir > 0.0 { [b, b + 2, b + 1] } else { [b, b + 1, b + 2] });
-    faces.push(if dir > 0.0 { [b, b + 3, b + 2] } else { [b, b + 2, b + 3] });
+    faces.push(if dir > 0.0 {
+        [b, b + 2, b + 1]
+    } else {
+        [b, b + 1, b + 2]
+    });
+    faces.push(if dir > 0.0 {
+        [b, b + 3, b + 2]
+    } else {
+        [b, b + 2, b + 3]
+    });
 }
 
 #[test]
@@ -123,7 +135,7 @@ fn duplicate_and_degenerate_faces_are_dropped() {
     faces.push(vec![faces[7][1], faces[7][2], faces[7][0]]); // the same face, rotated
     faces.push(vec![0, 0, 5]); // a repeated index
     faces.push(vec![1, 2, 1, 3]); // pinched
-    // A zero-area face on three new collinear points.
+                                  // A zero-area face on three new collinear points.
     pos.extend([Point3::ZERO, Point3::X * 0.1, Point3::X * 0.2]);
     let k = pos.len() as u32 - 3;
     faces.push(vec![k, k + 1, k + 2]);
@@ -205,7 +217,9 @@ fn a_moebius_strip_is_cut_open_and_reported() {
     assert_eq!(r.non_orientable_components, 1);
     assert!(r.cut_edges.count >= 1);
     assert_manifold(&out.mesh);
-    assert!(r.summary.contains("edges cut to orient non-orientable parts"));
+    assert!(r
+        .summary
+        .contains("edges cut to orient non-orientable parts"));
 }
 
 #[test]
@@ -232,7 +246,10 @@ fn tiny_components_are_left_to_the_data_only() {
 
 #[test]
 fn a_single_triangle_stays() {
-    let out = repaired(&mesh(vec![Point3::ZERO, Point3::X, Point3::Y], &[[0, 1, 2]]));
+    let out = repaired(&mesh(
+        vec![Point3::ZERO, Point3::X, Point3::Y],
+        &[[0, 1, 2]],
+    ));
     assert_eq!(out.mesh.num_faces(), 1);
     assert_eq!(out.report.summary, "nothing to repair");
     assert!(!out.report.changed());

@@ -12,5 +12,8 @@ pub use error::MeshError;
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
 pub use repair::{repair, repair_with, RepairOptions, RepairReport, Repaired};
-pub use simplify::{simplify, simplify_with, SimplifyError, SimplifyOptions};
+pub use simplify::{
+    simplify, simplify_with, simplify_with_report, Simplified, SimplifyError, SimplifyOptions,
+    SimplifyReport,
+};
 pub use validate::TopologyError;

@@ -60,6 +60,12 @@ impl PolyMesh {
         (&self.face_starts, &self.face_indices)
     }
 
+    /// The parts: positions, face offsets (face `i` is `indices[starts[i]..starts[i + 1]]`)
+    /// and face indices.
+    pub(crate) fn into_parts(self) -> (Vec<Point3>, Vec<u32>, Vec<u32>) {
+        (self.positions, self.face_starts, self.face_indices)
+    }
+
     /// Points only, no faces.
     pub fn from_points(positions: Vec<Point3>) -> Result<PolyMesh, MeshError> {
         PolyMesh::try_new(positions, std::iter::empty::<[u32; 3]>())

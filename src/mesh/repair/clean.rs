@@ -9,7 +9,7 @@ use crate::mesh::PolyMesh;
 /// A face is of zero area when twice its area is below this fraction of the sum of its
 /// squared side lengths: collinear corners to within rounding (a sliver of height h and
 /// length l has the ratio h / 2l).
-const ZERO_AREA_RATIO: f64 = 1e-12;
+pub(crate) const ZERO_AREA_RATIO: f64 = 1e-12;
 
 /// The input's faces without degenerate and zero-area ones (counted in `report`). Repeated
 /// corners in a row (`a a b c`) are merged first, as exporters write them for triangles
@@ -39,6 +39,12 @@ pub(super) fn clean(mesh: &PolyMesh, report: &mut RepairReport) -> Soup {
 /// `face` with runs of one vertex (cyclically) reduced to one corner, into `out`.
 fn merge_repeats(face: &[u32], out: &mut Vec<u32>) {
     out.clear();
+    if let [a, b, c] = *face {
+        if a != b && b != c && c != a {
+            out.extend_from_slice(face);
+            return;
+        }
+    }
     for (k, &v) in face.iter().enumerate() {
         if v != face[(k + 1) % face.len()] {
             out.push(v);
@@ -60,6 +66,11 @@ fn has_repeat(face: &[u32]) -> bool {
 /// Whether the polygon `face` has zero area: its Newell normal (twice the area vector) is
 /// negligible against its squared sides.
 fn zero_area(pos: &[Point3], face: &[u32]) -> bool {
+    if let [a, b, c] = *face {
+        let [a, b, c] = [a, b, c].map(|v| pos[v as usize]);
+        let sides = (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared();
+        return !((b - a).cross(c - a).length() > ZERO_AREA_RATIO * sides);
+    }
     let mut normal = Vec3::ZERO;
     let mut sides = 0.0;
     let origin = pos[face[0] as usize];

@@ -52,7 +52,14 @@ pub(super) fn split(soup: &Soup, twin: &[u32], vertices: usize) -> Fans {
 impl Fans {
     /// Gives vertex `id` to corner `start` and every corner of the same vertex reachable from
     /// it across glued sides.
-    fn claim_fan(&mut self, soup: &Soup, twin: &[u32], start: usize, id: u32, stack: &mut Vec<u32>) {
+    fn claim_fan(
+        &mut self,
+        soup: &Soup,
+        twin: &[u32],
+        start: usize,
+        id: u32,
+        stack: &mut Vec<u32>,
+    ) {
         let v = soup.idx[start];
         self.corner_vertex[start] = id;
         stack.push(start as u32);

@@ -44,7 +44,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod clean;
+pub(crate) mod clean;
 mod edges;
 mod fans;
 mod orient;
@@ -230,7 +230,9 @@ impl Work {
             });
         }
         for &v in &fans.split {
-            self.report.non_manifold_vertices.add(self.origin[v as usize] as usize);
+            self.report
+                .non_manifold_vertices
+                .add(self.origin[v as usize] as usize);
         }
         self.report.vertices_added += fans.copy_of.len();
         for &v in &fans.copy_of {

@@ -16,7 +16,7 @@ impl<T> Found<T> {
     pub const SHOWN: usize = 5;
 
     /// Counts `item`, and keeps it if fewer than [`Found::SHOWN`] are kept.
-    pub(super) fn add(&mut self, item: T) {
+    pub(crate) fn add(&mut self, item: T) {
         self.count += 1;
         if self.first.len() < Self::SHOWN {
             self.first.push(item);
@@ -96,16 +96,31 @@ impl RepairReport {
     }
 
     /// Sets [`RepairReport::summary`] from the counts.
-    pub(super) fn summarise(&mut self) {
+    pub(crate) fn summarise(&mut self) {
         let parts: Vec<String> = [
-            (self.non_manifold_vertices.count, "non-manifold vertices split"),
-            (self.detached_faces.count, "faces detached from non-manifold edges"),
-            (self.dropped_faces.count, "faces dropped at non-manifold edges"),
+            (
+                self.non_manifold_vertices.count,
+                "non-manifold vertices split",
+            ),
+            (
+                self.detached_faces.count,
+                "faces detached from non-manifold edges",
+            ),
+            (
+                self.dropped_faces.count,
+                "faces dropped at non-manifold edges",
+            ),
             (self.degenerate_faces.count, "degenerate faces dropped"),
             (self.zero_area_faces.count, "zero-area faces dropped"),
             (self.duplicate_faces.count, "duplicate faces dropped"),
-            (self.flipped_faces.count, "faces flipped to a consistent orientation"),
-            (self.cut_edges.count, "edges cut to orient non-orientable parts"),
+            (
+                self.flipped_faces.count,
+                "faces flipped to a consistent orientation",
+            ),
+            (
+                self.cut_edges.count,
+                "edges cut to orient non-orientable parts",
+            ),
             (
                 self.components.data_only_faces,
                 "faces of tiny components left to the data only",

@@ -13,16 +13,19 @@ pub(super) struct Soup {
     pub(super) idx: Vec<u32>,
     /// Input face of each face, for the report.
     pub(super) origin: Vec<u32>,
-    /// Face of each corner.
+    /// Face of each corner (empty when every face is a triangle: then it is `c / 3`).
     face_of: Vec<u32>,
 }
 
 impl Soup {
     /// A soup of the given faces (`starts` begins at 0 and has one entry more than `origin`).
     pub(super) fn new(starts: Vec<u32>, idx: Vec<u32>, origin: Vec<u32>) -> Soup {
-        let mut face_of = vec![0u32; idx.len()];
-        for (f, w) in starts.windows(2).enumerate() {
-            face_of[w[0] as usize..w[1] as usize].fill(f as u32);
+        let mut face_of = Vec::new();
+        if idx.len() != 3 * origin.len() {
+            face_of = vec![0u32; idx.len()];
+            for (f, w) in starts.windows(2).enumerate() {
+                face_of[w[0] as usize..w[1] as usize].fill(f as u32);
+            }
         }
         Soup {
             starts,
@@ -49,11 +52,18 @@ impl Soup {
 
     /// The face of corner `c`.
     pub(super) fn face_of(&self, c: usize) -> usize {
-        self.face_of[c] as usize
+        if self.face_of.is_empty() {
+            c / 3
+        } else {
+            self.face_of[c] as usize
+        }
     }
 
     /// The corner after `c` in its face (the far end of side `c`).
     pub(super) fn next(&self, c: usize) -> usize {
+        if self.face_of.is_empty() {
+            return if c % 3 == 2 { c - 2 } else { c + 1 };
+        }
         let f = self.face_of[c] as usize;
         if c + 1 == self.starts[f + 1] as usize {
             self.starts[f] as usize
@@ -64,6 +74,9 @@ impl Soup {
 
     /// The corner before `c` in its face.
     pub(super) fn prev(&self, c: usize) -> usize {
+        if self.face_of.is_empty() {
+            return if c % 3 == 0 { c + 2 } else { c - 1 };
+        }
         let f = self.face_of[c] as usize;
         if c == self.starts[f] as usize {
             self.starts[f + 1] as usize - 1

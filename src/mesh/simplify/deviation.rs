@@ -1,8 +1,9 @@
 //! How far a set of points lies from a triangle mesh: the measure of what simplification lost
 //! (the distance of every original vertex to the simplified surface).
 
-use crate::geom::{Aabb, Point3};
+use crate::geom::{Aabb, Point3, Vec3};
 use crate::mesh::PolyMesh;
+use serde::Serialize;
 
 /// Distances of points to a mesh, in the mesh's units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,18 +33,14 @@ impl Deviation {
 ///
 /// A bounding-volume hierarchy over the triangles makes this about O(n log m).
 pub fn deviation(points: &[Point3], mesh: &PolyMesh) -> Option<Deviation> {
-    let tris: Vec<[Point3; 3]> = mesh
-        .triangles()
-        .iter()
-        .map(|t| t.map(|i| mesh.positions()[i as usize]))
-        .collect();
+    let tris = corner_positions(mesh);
     if tris.is_empty() || points.is_empty() {
         return None;
     }
     let bvh = Bvh::build(&tris);
     let (mut max, mut sum, mut sum_sq) = (0.0f64, 0.0, 0.0);
     for &p in points {
-        let d = bvh.nearest_sq(&tris, p).sqrt();
+        let d = bvh.nearest(&tris, p).0.sqrt();
         max = max.max(d);
         sum += d;
         sum_sq += d * d;
@@ -54,6 +51,67 @@ pub fn deviation(points: &[Point3], mesh: &PolyMesh) -> Option<Deviation> {
         rms: (sum_sq / n).sqrt(),
         mean: sum / n,
     })
+}
+
+/// Below this cosine between a simplified face's normal and the normal of the input surface it
+/// covers, the face is folded over: a folded face points backwards (−1), while faces bridging
+/// a groove or cutting a sharp corner may lie sideways (near 0).
+const FOLDED_COS: f64 = -0.5;
+
+/// The faces of a simplified mesh that point against the input surface they stand for.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Foldovers {
+    /// Faces of the simplified mesh whose normal makes more than 120° with the area-weighted
+    /// normal of the input triangles nearest to it.
+    pub count: usize,
+    /// The first few of them (face indices of the simplified mesh).
+    pub first: Vec<usize>,
+    /// The smallest cosine between a simplified face and the input it covers (1 when no face
+    /// covers any input).
+    pub worst_cos: f64,
+}
+
+/// Fold-overs of `coarse` against `original`: every input triangle (polygons fan-triangulated)
+/// is assigned to the simplified triangle nearest to its centroid, and each simplified face is
+/// compared with the summed area normals of the triangles assigned to it.
+pub fn foldovers(original: &PolyMesh, coarse: &PolyMesh) -> Foldovers {
+    let tris: Vec<[Point3; 3]> = corner_positions(coarse);
+    let mut out = Foldovers {
+        count: 0,
+        first: Vec::new(),
+        worst_cos: 1.0,
+    };
+    if tris.is_empty() {
+        return out;
+    }
+    let bvh = Bvh::build(&tris);
+    let mut covered = vec![Vec3::ZERO; tris.len()];
+    for [a, b, c] in corner_positions(original) {
+        let (_, k) = bvh.nearest(&tris, (a + b + c) / 3.0);
+        covered[k] += (b - a).cross(c - a);
+    }
+    for (k, t) in tris.iter().enumerate() {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        let cos = n.dot(covered[k].normalize_or_zero());
+        if covered[k] != Vec3::ZERO && n != Vec3::ZERO {
+            out.worst_cos = out.worst_cos.min(cos);
+        }
+        if cos < FOLDED_COS {
+            out.count += 1;
+            if out.first.len() < 5 {
+                out.first.push(k);
+            }
+        }
+    }
+    out
+}
+
+/// The corner positions of every triangle of `mesh` (polygons fan-triangulated).
+fn corner_positions(mesh: &PolyMesh) -> Vec<[Point3; 3]> {
+    mesh.triangles()
+        .iter()
+        .map(|t| t.map(|i| mesh.positions()[i as usize]))
+        .collect()
 }
 
 /// Squared distance from `p` to triangle `t` (Ericson, Real-Time Collision Detection §5.1.5).
@@ -177,8 +235,10 @@ impl Bvh {
         id
     }
 
-    fn nearest_sq(&self, tris: &[[Point3; 3]], p: Point3) -> f64 {
+    /// The squared distance from `p` to the nearest triangle, and that triangle.
+    fn nearest(&self, tris: &[[Point3; 3]], p: Point3) -> (f64, usize) {
         let mut best = f64::INFINITY;
+        let mut best_t = 0;
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
@@ -188,7 +248,10 @@ impl Bvh {
             match node.kind {
                 NodeKind::Leaf(lo, hi) => {
                     for &t in &self.order[lo as usize..hi as usize] {
-                        best = best.min(point_triangle_dist_sq(p, &tris[t as usize]));
+                        let d = point_triangle_dist_sq(p, &tris[t as usize]);
+                        if d < best {
+                            (best, best_t) = (d, t as usize);
+                        }
                     }
                 }
                 NodeKind::Inner(l, r) => {
@@ -203,7 +266,7 @@ impl Bvh {
                 }
             }
         }
-        best
+        (best, best_t)
     }
 }
 
@@ -258,7 +321,7 @@ mod tests {
                 .iter()
                 .map(|t| point_triangle_dist_sq(p, t))
                 .fold(f64::INFINITY, f64::min);
-            assert!((bvh.nearest_sq(&tris, p) - brute).abs() < 1e-12);
+            assert!((bvh.nearest(&tris, p).0 - brute).abs() < 1e-12);
         }
     }
 }
