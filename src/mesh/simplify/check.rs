@@ -20,12 +20,16 @@ pub(super) struct Limits {
     pub(super) min_quality: f64,
     /// Largest valence the merged vertex may get, unless one of the ends already had more.
     pub(super) max_valence: usize,
+    /// Cosine of the largest angle between a face's normal and the normal of the input it
+    /// stands for.
+    pub(super) min_reference_cos: f64,
 }
 
-/// A face around a vertex, seen from it: the corner after it and the corner before it (in the
-/// face's orientation), and the face's input normal.
+/// A face around a vertex, seen from it: the face, the corner after the vertex and the corner
+/// before it (in the face's orientation), and the normal of the input the face stands for.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Corner {
+    pub(super) face: u32,
     pub(super) next: u32,
     pub(super) prev: u32,
     pub(super) normal: Vec3,
@@ -73,6 +77,29 @@ impl Ring {
     /// The third corners of the faces on the edge.
     pub(super) fn opposite(&self) -> &[u32] {
         &self.opposite[..self.shared.min(2)]
+    }
+
+    /// The faces the collapse of `a`–`b` removes, each with its input normal and the faces
+    /// that inherit it: the faces across its other two sides (which become neighbours), where
+    /// they exist.
+    pub(super) fn removed_faces(&self, a: u32, b: u32) -> Vec<(Vec3, [Option<u32>; 2])> {
+        let heir = |around: &[Corner], x: u32, other: u32| {
+            around
+                .iter()
+                .find(|c| c.has(x) && !c.has(other))
+                .map(|c| c.face)
+        };
+        self.around_a
+            .iter()
+            .filter(|c| c.has(b))
+            .map(|c| {
+                let x = if c.next == b { c.prev } else { c.next };
+                (
+                    c.normal,
+                    [heir(&self.around_a, x, b), heir(&self.around_b, x, a)],
+                )
+            })
+            .collect()
     }
 
     /// Faces the merged vertex keeps.
@@ -131,7 +158,7 @@ impl Ring {
                 let n_old = (u - x).cross(w - x);
                 let n_new = (u - p).cross(w - p);
                 if n_new == Vec3::ZERO
-                    || n_new.dot(c.normal) < 0.0
+                    || !within(c.normal, n_new, l.min_reference_cos)
                     || !within(n_old, n_new, l.min_normal_cos)
                 {
                     return false;

@@ -58,11 +58,18 @@ pub fn deviation(points: &[Point3], mesh: &PolyMesh) -> Option<Deviation> {
 /// a groove or cutting a sharp corner may lie sideways (near 0).
 const FOLDED_COS: f64 = -0.5;
 
+/// The input a face covers has a direction only when its triangles agree: the length of their
+/// summed area normals is at least this share of their summed areas. Two sheets facing apart
+/// (both sides of a thin part, or an input that is two-sided in places) cancel, and no
+/// orientation of a face between them could agree with both.
+const COHERENT: f64 = 0.5;
+
 /// The faces of a simplified mesh that point against the input surface they stand for.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Foldovers {
     /// Faces of the simplified mesh whose normal makes more than 120° with the area-weighted
-    /// normal of the input triangles nearest to it.
+    /// normal of the input triangles nearest to it, where those agree among themselves (see
+    /// [`foldovers`]).
     pub count: usize,
     /// The first few of them (face indices of the simplified mesh).
     pub first: Vec<usize>,
@@ -73,7 +80,10 @@ pub struct Foldovers {
 
 /// Fold-overs of `coarse` against `original`: every input triangle (polygons fan-triangulated)
 /// is assigned to the simplified triangle nearest to its centroid, and each simplified face is
-/// compared with the summed area normals of the triangles assigned to it.
+/// compared with the summed area normals of the triangles assigned to it when they are
+/// coherent (their sum at least half their summed areas). Input triangles that face away from
+/// a triangle they share a vertex with (by more than 120°: fins, flattened pockets, both sides
+/// of a sheet) do not count: no face can agree with both sides of them.
 pub fn foldovers(original: &PolyMesh, coarse: &PolyMesh) -> Foldovers {
     let tris: Vec<[Point3; 3]> = corner_positions(coarse);
     let mut out = Foldovers {
@@ -86,20 +96,71 @@ pub fn foldovers(original: &PolyMesh, coarse: &PolyMesh) -> Foldovers {
     }
     let bvh = Bvh::build(&tris);
     let mut covered = vec![Vec3::ZERO; tris.len()];
-    for [a, b, c] in corner_positions(original) {
+    let mut area = vec![0.0; tris.len()];
+    let input = original.triangles();
+    let two_sided = folded_back(original.positions(), &input);
+    let pos = original.positions();
+    for (t, _) in input.iter().zip(&two_sided).filter(|(_, &x)| !x) {
+        let [a, b, c] = t.map(|v| pos[v as usize]);
         let (_, k) = bvh.nearest(&tris, (a + b + c) / 3.0);
-        covered[k] += (b - a).cross(c - a);
+        let n = (b - a).cross(c - a);
+        covered[k] += n;
+        area[k] += n.length();
     }
     for (k, t) in tris.iter().enumerate() {
+        let coherent = covered[k].length() >= COHERENT * area[k] && area[k] > 0.0;
         let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
         let cos = n.dot(covered[k].normalize_or_zero());
-        if covered[k] != Vec3::ZERO && n != Vec3::ZERO {
-            out.worst_cos = out.worst_cos.min(cos);
+        if !coherent || n == Vec3::ZERO {
+            continue;
         }
+        out.worst_cos = out.worst_cos.min(cos);
         if cos < FOLDED_COS {
             out.count += 1;
             if out.first.len() < 5 {
                 out.first.push(k);
+            }
+        }
+    }
+    out
+}
+
+/// Whether each of `tris` faces away (by more than 120°) from a triangle it shares a vertex
+/// with.
+fn folded_back(pos: &[Point3], tris: &[[u32; 3]]) -> Vec<bool> {
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| pos[v as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let mut start = vec![0u32; pos.len() + 1];
+    for t in tris {
+        for &v in t {
+            start[v as usize + 1] += 1;
+        }
+    }
+    for v in 0..pos.len() {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; 3 * tris.len()];
+    for (f, t) in tris.iter().enumerate() {
+        for &v in t {
+            around[fill[v as usize] as usize] = f as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let mut out = vec![false; tris.len()];
+    let mut normals = Vec::new();
+    for w in start.windows(2) {
+        let faces = &around[w[0] as usize..w[1] as usize];
+        normals.clear();
+        normals.extend(faces.iter().map(|&f| normal(&tris[f as usize])));
+        for i in 0..faces.len() {
+            for j in 0..i {
+                if normals[i].dot(normals[j]) < FOLDED_COS {
+                    out[faces[i] as usize] = true;
+                    out[faces[j] as usize] = true;
+                }
             }
         }
     }

@@ -45,8 +45,10 @@ struct Candidate {
     cost: f64,
 }
 
-/// A triangle of the working mesh with its unit normal in the input (a face may never turn
-/// against it, which catches fold-overs built up by many small rotations): one record, as the
+/// A triangle of the working mesh with the area-weighted normal of the input it stands for:
+/// its own input triangle's, plus shares of the faces that collapses removed next to it. A
+/// face may never turn against it, which catches fold-overs built up by many small rotations
+/// and faces that end up facing away from the surface they replace. One record, as the
 /// collapse test reads both for every face around an edge.
 #[derive(Clone, Copy, Debug)]
 struct Face {
@@ -58,6 +60,7 @@ struct Face {
 pub(super) struct Engine {
     pos: Vec<Point3>,
     quadric: Vec<Quadric>,
+
     /// Live triangles, in spatial order.
     tris: Vec<Face>,
     /// Whether each vertex has an edge with one face.
@@ -92,12 +95,12 @@ impl Engine {
         let n = pos.len();
         let numbering = Numbering::spatial(&pos);
         let (pos, tris) = numbering.apply(pos, tris);
-        let tris = tris
+        let tris: Vec<Face> = tris
             .chunks_exact(3)
             .map(|t| {
                 let v = [t[0], t[1], t[2]];
                 let [a, b, c] = v.map(|v| pos[v as usize]);
-                let normal = (b - a).cross(c - a).normalize_or_zero();
+                let normal = 0.5 * (b - a).cross(c - a);
                 Face { v, normal }
             })
             .collect();
@@ -188,6 +191,7 @@ impl Engine {
             let prev = self.remap[t[(k + 2) % 3] as usize];
             if next != prev {
                 out.push(Corner {
+                    face: f,
                     next,
                     prev,
                     normal: face.normal,
@@ -283,25 +287,33 @@ impl Engine {
         quadric
     }
 
-    /// One pass of collapses towards `target` within `limits`; returns how many were made.
+    /// One pass of collapses towards `target` within `limits`; returns how many were made
+    /// (none only when no edge could be collapsed).
     pub(super) fn pass(&mut self, target: usize, limits: &Limits) -> usize {
-        let mut candidates = self.candidates();
+        let mut dear = self.candidates();
         let needed = self.live.saturating_sub(target);
-        let goal = GOAL_FACTOR * cost_at_rank(candidates.iter().map(|c| c.cost), needed);
-        let threshold = goal.max(self.worst);
-        // The waves see only the candidates within the goal; the others wait in case the
-        // pass has to go beyond it.
-        let mut dear: Vec<Candidate> = Vec::new();
-        candidates.retain(|&c| {
-            c.cost <= threshold || {
-                dear.push(c);
-                false
+        let enough = needed / MIN_PASS_SHARE;
+        let goal = GOAL_FACTOR * cost_at_rank(dear.iter().map(|c| c.cost), needed);
+        let mut threshold = goal.max(self.worst);
+        let mut open = Vec::new();
+        let mut done = 0;
+        loop {
+            // The waves see the candidates up to the threshold; the dearer ones wait.
+            dear.retain(|&c| {
+                let ends_open = !self.locked[c.a as usize] && !self.locked[c.b as usize];
+                if ends_open && c.cost <= threshold {
+                    open.push(c);
+                }
+                ends_open && c.cost > threshold
+            });
+            done += self.waves(&mut open, target, limits);
+            if done > enough || self.live <= target || dear.is_empty() {
+                break;
             }
-        });
-        let mut done = self.waves(&mut candidates, target, limits);
-        if done <= needed / MIN_PASS_SHARE && self.live > target {
-            candidates.append(&mut dear);
-            done += self.waves(&mut candidates, target, limits);
+            // Too little within the goal (most collapses refused): admit about as many more
+            // candidates as the pass still lacks, cheapest first.
+            let lacking = enough + 1 - done;
+            threshold = cost_at_rank(dear.iter().map(|c| c.cost), lacking.min(dear.len() - 1));
         }
         self.compact();
         self.index_faces();
@@ -417,6 +429,12 @@ impl Engine {
         self.face_count[bi] = 0;
         for &w in ring.opposite() {
             self.face_count[w as usize] -= 1;
+        }
+        for (normal, heirs) in ring.removed_faces(a, b) {
+            let share = normal / heirs.iter().flatten().count().max(1) as f64;
+            for g in heirs.into_iter().flatten() {
+                self.tris[g as usize].normal += share;
+            }
         }
         self.live -= 1;
     }

@@ -167,12 +167,14 @@ impl SimplifyOptions {
             min_normal_cos: self.max_normal_change_deg.to_radians().cos(),
             min_quality: self.min_triangle_quality,
             max_valence: self.max_valence,
+            min_reference_cos: REFERENCE_COS,
         };
         let mut stages = vec![first];
         for (degrees, quality) in RELAXED {
             let next = Limits {
                 min_normal_cos: first.min_normal_cos.min(f64::to_radians(degrees).cos()),
                 min_quality: first.min_quality.min(quality),
+                min_reference_cos: 0.0,
                 ..first
             };
             if stages.last() != Some(&next) {
@@ -182,6 +184,10 @@ impl SimplifyOptions {
         stages
     }
 }
+
+/// Cosine of the largest angle (about 75°) between a face and the input it stands for under
+/// the configured limits; the relaxed ones allow up to a right angle, never more.
+const REFERENCE_COS: f64 = 0.25;
 
 /// The smallest valence cap accepted: a regular interior vertex has 6 neighbours.
 const MIN_VALENCE_CAP: usize = 6;

@@ -26,7 +26,13 @@ pub(super) fn cost_at_rank(costs: impl Iterator<Item = f64> + Clone, n: usize) -
     for (b, &k) in count.iter().enumerate() {
         seen += k as usize;
         if seen > n {
-            return f64::from_bits(((b as u64) + 1) << SHIFT);
+            // The bin of infinity (and of the largest finite costs) has no finite bound.
+            let bound = f64::from_bits(((b as u64) + 1) << SHIFT);
+            return if bound.is_finite() {
+                bound
+            } else {
+                f64::INFINITY
+            };
         }
     }
     f64::INFINITY
@@ -38,7 +44,17 @@ mod tests {
 
     #[test]
     fn the_rank_bounds_the_cost_from_above_within_a_bin() {
-        let costs = [3.0, 0.0, 1e-30, 2.0, 3.0, 1e300, 2.0, f64::NAN];
+        let costs = [
+            3.0,
+            0.0,
+            1e-30,
+            2.0,
+            3.0,
+            1e300,
+            2.0,
+            f64::NAN,
+            f64::INFINITY,
+        ];
         let at = |n| cost_at_rank(costs.iter().copied(), n);
         assert!(at(0) > 0.0 && at(0) < 1e-300);
         assert!(at(1) >= 1e-30 && at(1) < 1.07e-30);
@@ -46,6 +62,7 @@ mod tests {
         assert_eq!(at(3), at(2));
         assert!(at(6) >= 1e300);
         assert_eq!(at(7), f64::INFINITY);
+        assert_eq!(at(8), f64::INFINITY);
     }
 
     #[test]
