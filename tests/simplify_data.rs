@@ -9,7 +9,7 @@ use common::manifold::{assert_manifold, boundary_loops, euler_characteristic};
 use geofit::cloud::{reconstruct, ReconstructOptions};
 use geofit::mesh::simplify::{deviation, foldovers};
 use geofit::mesh::{repair, simplify_with_report, ControlMesh, PolyMesh, SimplifyOptions};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// The meshes of the shared data and corpus, or `None` (with a message) where they are absent.
 fn shared_meshes() -> Option<Vec<PathBuf>> {
@@ -33,7 +33,7 @@ fn shared_meshes() -> Option<Vec<PathBuf>> {
 }
 
 /// The file's mesh; a bare point file is meshed first.
-fn surface(path: &PathBuf) -> PolyMesh {
+fn surface(path: &Path) -> PolyMesh {
     let loaded = geofit::io::read_path(path).unwrap();
     if !loaded.mesh.is_point_cloud() {
         return loaded.mesh;

@@ -9,7 +9,13 @@ use crate::mesh::PolyMesh;
 /// A face is of zero area when twice its area is below this fraction of the sum of its
 /// squared side lengths: collinear corners to within rounding (a sliver of height h and
 /// length l has the ratio h / 2l).
-pub(crate) const ZERO_AREA_RATIO: f64 = 1e-12;
+const ZERO_AREA_RATIO: f64 = 1e-12;
+
+/// Whether a face whose doubled area is `twice_area` and whose squared sides sum to `sides`
+/// has an area (false for NaN: an overflowed area is no area).
+pub(crate) fn has_area(twice_area: f64, sides: f64) -> bool {
+    twice_area > ZERO_AREA_RATIO * sides
+}
 
 /// The input's faces without degenerate and zero-area ones (counted in `report`). Repeated
 /// corners in a row (`a a b c`) are merged first, as exporters write them for triangles
@@ -69,7 +75,7 @@ fn zero_area(pos: &[Point3], face: &[u32]) -> bool {
     if let [a, b, c] = *face {
         let [a, b, c] = [a, b, c].map(|v| pos[v as usize]);
         let sides = (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared();
-        return !((b - a).cross(c - a).length() > ZERO_AREA_RATIO * sides);
+        return !has_area((b - a).cross(c - a).length(), sides);
     }
     let mut normal = Vec3::ZERO;
     let mut sides = 0.0;
@@ -80,8 +86,7 @@ fn zero_area(pos: &[Point3], face: &[u32]) -> bool {
         normal += a.cross(b);
         sides += (b - a).length_squared();
     }
-    // `!(x > y)` rather than `x <= y`: an overflowed (NaN) area counts as zero, not as a face.
-    !(normal.length() > ZERO_AREA_RATIO * sides)
+    !has_area(normal.length(), sides)
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@
 //! repair to leave it to the data only.
 
 use super::engine::Engine;
-use crate::mesh::repair::clean::ZERO_AREA_RATIO;
+use crate::mesh::repair::clean::has_area;
 use crate::mesh::repair::{RepairOptions, RepairReport};
 
 /// The report of a repair that found nothing to do, or `None` when the mesh needs repair.
@@ -49,7 +49,7 @@ fn face_is_sound(e: &Engine, f: usize) -> bool {
     }
     let [a, b, c] = t.map(|v| e.pos(v));
     let sides = (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared();
-    (b - a).cross(c - a).length() > ZERO_AREA_RATIO * sides
+    has_area((b - a).cross(c - a).length(), sides)
 }
 
 /// Whether the faces of `v` form one fan with each side once (see the module docs);
