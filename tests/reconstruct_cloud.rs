@@ -6,7 +6,7 @@ mod common;
 use common::manifold::{assert_manifold, boundary_loops, euler_characteristic};
 use geofit::cloud::{reconstruct, ReconstructError, ReconstructOptions, SurfaceKind};
 use geofit::geom::Point3;
-use geofit::mesh::simplify::deviation;
+use geofit::mesh::deviation;
 use geofit::mesh::{simplify, ControlMesh};
 use std::time::Instant;
 

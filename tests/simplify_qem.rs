@@ -5,9 +5,10 @@ mod common;
 
 use common::manifold::{assert_manifold, boundary_edges, boundary_loops, euler_characteristic};
 use geofit::geom::{Point3, Vec3};
-use geofit::mesh::simplify::deviation;
+use geofit::mesh::deviation;
 use geofit::mesh::{
-    simplify, simplify_with, ControlMesh, PolyMesh, SimplifyError, SimplifyOptions,
+    simplify, simplify_with, simplify_with_report, ControlMesh, PolyMesh, SimplifyError,
+    SimplifyOptions,
 };
 use std::collections::BTreeMap;
 
@@ -204,12 +205,13 @@ fn bunny_to_612_is_manifold_accurate_and_keeps_its_five_holes() {
     assert_eq!(boundary_loops(&bunny), 5);
     assert_no_foldover(&bunny, &coarse, 5);
     let diag = bunny.bbox().unwrap().diagonal();
-    // MeshLab's QEM gives max 0.76 %, rms 0.157 % of the diagonal (SPEC §5).
+    // MeshLab's QEM gives max 0.76 %, rms 0.157 % of the diagonal (SPEC §5); the queue-based
+    // simplifier this one replaced gave max 0.752 %, rms 0.143 % (issue 15 asks for no worse).
     let dev = deviation(bunny.positions(), &coarse)
         .unwrap()
         .percent_of(diag);
     println!("bunny -> 612: {dev:?}");
-    assert!(dev.max <= 0.76 && dev.rms <= 0.157, "{dev:?}");
+    assert!(dev.max <= 0.752 && dev.rms <= 0.143, "{dev:?}");
     let drift = boundary_drift(&bunny, &coarse) / diag * 100.0;
     println!("bunny -> 612: hole outlines within {drift:.3} % of the diagonal");
     // The scanned hole outlines are jagged; a few coarse vertices follow them within ~1 %.
@@ -225,23 +227,9 @@ fn bad_input_gives_typed_errors() {
     );
     let cloud = PolyMesh::from_points(grid.positions().to_vec()).unwrap();
     assert_eq!(simplify(&cloud, 4), Err(SimplifyError::NoFaces));
-    assert_eq!(
-        simplify(&grid, 3),
-        Err(SimplifyError::TargetTooSmall { target: 3, min: 4 })
-    );
-    assert_eq!(
-        simplify(&grid, 26),
-        Err(SimplifyError::TargetTooLarge {
-            target: 26,
-            available: 25
-        })
-    );
-    // A lone triangle has too few vertices for any target.
-    let tri = PolyMesh::try_new(vec![Point3::ZERO, Point3::X, Point3::Y], [[0, 1, 2]]).unwrap();
-    assert!(matches!(
-        simplify(&tri, 4),
-        Err(SimplifyError::TargetTooLarge { available: 3, .. })
-    ));
+    // Faces that repair must drop leave nothing to simplify.
+    let flat = PolyMesh::try_new(vec![Point3::ZERO, Point3::X, Point3::X * 2.0], [[0, 1, 2]]);
+    assert_eq!(simplify(&flat.unwrap(), 3), Err(SimplifyError::NoFaces));
     let bad = SimplifyOptions::default().with_max_normal_change_deg(f64::NAN);
     assert!(matches!(
         simplify_with(&grid, 10, &bad),
@@ -258,10 +246,37 @@ fn bad_input_gives_typed_errors() {
             ..
         })
     ));
+    let bad = SimplifyOptions::default().with_max_valence(3);
+    assert!(matches!(
+        simplify_with(&grid, 10, &bad),
+        Err(SimplifyError::InvalidOption {
+            name: "max_valence",
+            ..
+        })
+    ));
 }
 
 #[test]
-fn minimal_components_make_the_target_unreachable() {
+fn targets_out_of_reach_give_the_floor_or_everything() {
+    // A disc goes down to one triangle; a target above the vertex count keeps them all.
+    let grid = wavy_grid(5);
+    let low = simplify_with_report(&grid, 0, &SimplifyOptions::default()).unwrap();
+    assert_eq!(low.mesh.num_vertices(), 3);
+    let note = low.report.floor_note.expect("a note");
+    assert!(note.contains("stopped at 3 vertices"), "{note}");
+    assert!(
+        note.contains("1 components, Euler characteristic 1, 1 boundary loops"),
+        "{note}"
+    );
+    let high = simplify_with_report(&grid, 26, &SimplifyOptions::default()).unwrap();
+    assert_eq!(high.mesh.num_vertices(), 25);
+    assert_eq!(high.report.floor_note, None);
+    let tri = PolyMesh::try_new(vec![Point3::ZERO, Point3::X, Point3::Y], [[0, 1, 2]]).unwrap();
+    assert_eq!(simplify(&tri, 4).unwrap().num_vertices(), 3);
+}
+
+#[test]
+fn minimal_components_stop_at_their_floor() {
     // Two separate tetrahedra: neither can lose a vertex and stay a closed surface.
     let mut pos = Vec::new();
     let mut faces = Vec::new();
@@ -277,14 +292,14 @@ fn minimal_components_make_the_target_unreachable() {
         ]);
     }
     let two = PolyMesh::try_new(pos, faces).unwrap();
-    assert_eq!(
-        simplify(&two, 4),
-        Err(SimplifyError::TargetUnreachable {
-            target: 4,
-            reached: 8
-        })
+    let out = simplify_with_report(&two, 4, &SimplifyOptions::default()).unwrap();
+    assert_eq!(out.mesh.num_triangles(), 8);
+    assert_eq!(out.report.vertices, 8);
+    let note = out.report.floor_note.unwrap();
+    assert!(
+        note.contains("2 components, Euler characteristic 4, 0 boundary loops"),
+        "{note}"
     );
-    assert_eq!(simplify(&two, 8).unwrap().num_triangles(), 8);
 }
 
 #[test]

@@ -47,7 +47,7 @@ pub use error::ReconstructError;
 
 use crate::geom::{Point3, Vec3};
 use crate::io::RangeGrid;
-use crate::mesh::simplify::{simplify_with, SimplifyOptions};
+use crate::mesh::{simplify_with, SimplifyOptions};
 use crate::mesh::PolyMesh;
 use neighbours::{median, Neighbours};
 

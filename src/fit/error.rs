@@ -103,13 +103,10 @@ pub enum FitError {
     /// QEM simplification could not make the initial control mesh.
     ///
     /// ```
-    /// use geofit::fit::{initial_control, FitError};
-    /// use geofit::geom::Point3;
-    /// use geofit::mesh::PolyMesh;
-    /// let p = vec![Point3::ZERO, Point3::X, Point3::Y];
-    /// let tri = PolyMesh::try_new(p, vec![[0, 1, 2]]).unwrap();
-    /// let err = initial_control(&tri, Some(10)).err();
-    /// assert!(matches!(err, Some(FitError::Simplify(_))), "{err:?}");
+    /// use geofit::fit::FitError;
+    /// use geofit::mesh::SimplifyError;
+    /// let e: FitError = SimplifyError::NoFaces.into();
+    /// assert!(e.to_string().starts_with("invalid control mesh: simplification: "));
     /// ```
     #[error("invalid control mesh: simplification: {0}")]
     Simplify(#[from] SimplifyError),

@@ -1,14 +1,19 @@
 //! Polygon meshes: the in-memory form of every point or mesh file, and the control meshes that
-//! subdivision and fitting work on.
+//! subdivision and fitting work on; their repair on intake and their QEM simplification.
 
 mod error;
 mod halfedge;
 mod poly;
-pub mod simplify;
+mod repair;
+mod simplify;
 mod validate;
 
 pub use error::MeshError;
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
-pub use simplify::{simplify, simplify_with, SimplifyError, SimplifyOptions};
+pub use repair::{repair, repair_with, Components, Found, RepairOptions, RepairReport, Repaired};
+pub use simplify::{
+    deviation, foldovers, simplify, simplify_with, simplify_with_report, Deviation, Foldovers,
+    Relaxation, Simplified, SimplifyError, SimplifyOptions, SimplifyReport,
+};
 pub use validate::{check_oriented_edges, TopologyError};

@@ -40,6 +40,32 @@ impl PolyMesh {
         Ok(mesh)
     }
 
+    /// A mesh from parts the caller has checked: finite positions, `face_starts` beginning at 0
+    /// and increasing by at least 3, and every index of `face_indices` below the vertex count.
+    /// For the crate's own algorithms, whose output meets these by construction.
+    pub(crate) fn from_parts_unchecked(
+        positions: Vec<Point3>,
+        face_starts: Vec<u32>,
+        face_indices: Vec<u32>,
+    ) -> PolyMesh {
+        PolyMesh {
+            positions,
+            face_starts,
+            face_indices,
+        }
+    }
+
+    /// The face storage as it is: face `i` is `indices[starts[i]..starts[i + 1]]`.
+    pub(crate) fn raw_faces(&self) -> (&[u32], &[u32]) {
+        (&self.face_starts, &self.face_indices)
+    }
+
+    /// The parts: positions, face offsets (face `i` is `indices[starts[i]..starts[i + 1]]`)
+    /// and face indices.
+    pub(crate) fn into_parts(self) -> (Vec<Point3>, Vec<u32>, Vec<u32>) {
+        (self.positions, self.face_starts, self.face_indices)
+    }
+
     /// Points only, no faces.
     pub fn from_points(positions: Vec<Point3>) -> Result<PolyMesh, MeshError> {
         PolyMesh::try_new(positions, std::iter::empty::<[u32; 3]>())

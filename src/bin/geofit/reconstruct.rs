@@ -3,7 +3,7 @@
 
 use crate::output::{print_json, read_input};
 use geofit::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
-use geofit::mesh::simplify::deviation;
+use geofit::mesh::deviation;
 use std::path::PathBuf;
 use std::time::Instant;
 

@@ -27,7 +27,7 @@ pub fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<PolyMes
     }
     let used = used_vertices(data);
     let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
-    Ok(crate::mesh::simplify::simplify(data, target)?)
+    Ok(crate::mesh::simplify(data, target)?)
 }
 
 /// What [`build_subdiv_fitter`] made of bare points before simplifying: goes into the fit

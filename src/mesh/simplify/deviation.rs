@@ -1,8 +1,9 @@
 //! How far a set of points lies from a triangle mesh: the measure of what simplification lost
 //! (the distance of every original vertex to the simplified surface).
 
-use crate::geom::{Aabb, Point3};
+use crate::geom::{Aabb, Point3, Vec3};
 use crate::mesh::PolyMesh;
+use serde::Serialize;
 
 /// Distances of points to a mesh, in the mesh's units.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,18 +33,14 @@ impl Deviation {
 ///
 /// A bounding-volume hierarchy over the triangles makes this about O(n log m).
 pub fn deviation(points: &[Point3], mesh: &PolyMesh) -> Option<Deviation> {
-    let tris: Vec<[Point3; 3]> = mesh
-        .triangles()
-        .iter()
-        .map(|t| t.map(|i| mesh.positions()[i as usize]))
-        .collect();
+    let tris = corner_positions(mesh);
     if tris.is_empty() || points.is_empty() {
         return None;
     }
     let bvh = Bvh::build(&tris);
     let (mut max, mut sum, mut sum_sq) = (0.0f64, 0.0, 0.0);
     for &p in points {
-        let d = bvh.nearest_sq(&tris, p).sqrt();
+        let d = bvh.nearest(&tris, p).0.sqrt();
         max = max.max(d);
         sum += d;
         sum_sq += d * d;
@@ -54,6 +51,128 @@ pub fn deviation(points: &[Point3], mesh: &PolyMesh) -> Option<Deviation> {
         rms: (sum_sq / n).sqrt(),
         mean: sum / n,
     })
+}
+
+/// Below this cosine between a simplified face's normal and the normal of the input surface it
+/// covers, the face is folded over: a folded face points backwards (−1), while faces bridging
+/// a groove or cutting a sharp corner may lie sideways (near 0).
+const FOLDED_COS: f64 = -0.5;
+
+/// The input a face covers has a direction only when its triangles agree: the length of their
+/// summed area normals is at least this share of their summed areas. Two sheets facing apart
+/// (both sides of a thin part, or an input that is two-sided in places) cancel, and no
+/// orientation of a face between them could agree with both.
+const COHERENT: f64 = 0.5;
+
+/// The faces of a simplified mesh that point against the input surface they stand for.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Foldovers {
+    /// Faces of the simplified mesh whose normal makes more than 120° with the area-weighted
+    /// normal of the input triangles nearest to it, where those agree among themselves (see
+    /// [`foldovers`]).
+    pub count: usize,
+    /// The first few of them (face indices of the simplified mesh).
+    pub first: Vec<usize>,
+    /// The smallest cosine between a simplified face and the input it covers (1 when no face
+    /// covers any input).
+    pub worst_cos: f64,
+}
+
+/// Fold-overs of `coarse` against `original`: every input triangle (polygons fan-triangulated)
+/// is assigned to the simplified triangle nearest to its centroid, and each simplified face is
+/// compared with the summed area normals of the triangles assigned to it when they are
+/// coherent (their sum at least half their summed areas). Input triangles that face away from
+/// a triangle they share a vertex with (by more than 120°: fins, flattened pockets, both sides
+/// of a sheet) do not count: no face can agree with both sides of them.
+pub fn foldovers(original: &PolyMesh, coarse: &PolyMesh) -> Foldovers {
+    let tris: Vec<[Point3; 3]> = corner_positions(coarse);
+    let mut out = Foldovers {
+        count: 0,
+        first: Vec::new(),
+        worst_cos: 1.0,
+    };
+    if tris.is_empty() {
+        return out;
+    }
+    let bvh = Bvh::build(&tris);
+    let mut covered = vec![Vec3::ZERO; tris.len()];
+    let mut area = vec![0.0; tris.len()];
+    let input = original.triangles();
+    let two_sided = folded_back(original.positions(), &input);
+    let pos = original.positions();
+    for (t, _) in input.iter().zip(&two_sided).filter(|(_, &x)| !x) {
+        let [a, b, c] = t.map(|v| pos[v as usize]);
+        let (_, k) = bvh.nearest(&tris, (a + b + c) / 3.0);
+        let n = (b - a).cross(c - a);
+        covered[k] += n;
+        area[k] += n.length();
+    }
+    for (k, t) in tris.iter().enumerate() {
+        let coherent = covered[k].length() >= COHERENT * area[k] && area[k] > 0.0;
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        let cos = n.dot(covered[k].normalize_or_zero());
+        if !coherent || n == Vec3::ZERO {
+            continue;
+        }
+        out.worst_cos = out.worst_cos.min(cos);
+        if cos < FOLDED_COS {
+            out.count += 1;
+            if out.first.len() < 5 {
+                out.first.push(k);
+            }
+        }
+    }
+    out
+}
+
+/// Whether each of `tris` faces away (by more than 120°) from a triangle it shares a vertex
+/// with.
+fn folded_back(pos: &[Point3], tris: &[[u32; 3]]) -> Vec<bool> {
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| pos[v as usize]);
+        (b - a).cross(c - a).normalize_or_zero()
+    };
+    let mut start = vec![0u32; pos.len() + 1];
+    for t in tris {
+        for &v in t {
+            start[v as usize + 1] += 1;
+        }
+    }
+    for v in 0..pos.len() {
+        start[v + 1] += start[v];
+    }
+    let mut fill = start.clone();
+    let mut around = vec![0u32; 3 * tris.len()];
+    for (f, t) in tris.iter().enumerate() {
+        for &v in t {
+            around[fill[v as usize] as usize] = f as u32;
+            fill[v as usize] += 1;
+        }
+    }
+    let mut out = vec![false; tris.len()];
+    let mut normals = Vec::new();
+    for w in start.windows(2) {
+        let faces = &around[w[0] as usize..w[1] as usize];
+        normals.clear();
+        normals.extend(faces.iter().map(|&f| normal(&tris[f as usize])));
+        for i in 0..faces.len() {
+            for j in 0..i {
+                if normals[i].dot(normals[j]) < FOLDED_COS {
+                    out[faces[i] as usize] = true;
+                    out[faces[j] as usize] = true;
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The corner positions of every triangle of `mesh` (polygons fan-triangulated).
+fn corner_positions(mesh: &PolyMesh) -> Vec<[Point3; 3]> {
+    mesh.triangles()
+        .iter()
+        .map(|t| t.map(|i| mesh.positions()[i as usize]))
+        .collect()
 }
 
 /// Squared distance from `p` to triangle `t` (Ericson, Real-Time Collision Detection §5.1.5).
@@ -177,8 +296,10 @@ impl Bvh {
         id
     }
 
-    fn nearest_sq(&self, tris: &[[Point3; 3]], p: Point3) -> f64 {
+    /// The squared distance from `p` to the nearest triangle, and that triangle.
+    fn nearest(&self, tris: &[[Point3; 3]], p: Point3) -> (f64, usize) {
         let mut best = f64::INFINITY;
+        let mut best_t = 0;
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
@@ -188,7 +309,10 @@ impl Bvh {
             match node.kind {
                 NodeKind::Leaf(lo, hi) => {
                     for &t in &self.order[lo as usize..hi as usize] {
-                        best = best.min(point_triangle_dist_sq(p, &tris[t as usize]));
+                        let d = point_triangle_dist_sq(p, &tris[t as usize]);
+                        if d < best {
+                            (best, best_t) = (d, t as usize);
+                        }
                     }
                 }
                 NodeKind::Inner(l, r) => {
@@ -203,7 +327,7 @@ impl Bvh {
                 }
             }
         }
-        best
+        (best, best_t)
     }
 }
 
@@ -258,7 +382,7 @@ mod tests {
                 .iter()
                 .map(|t| point_triangle_dist_sq(p, t))
                 .fold(f64::INFINITY, f64::min);
-            assert!((bvh.nearest_sq(&tris, p) - brute).abs() < 1e-12);
+            assert!((bvh.nearest(&tris, p).0 - brute).abs() < 1e-12);
         }
     }
 }

@@ -4,9 +4,20 @@
 //! sum of squared distances of the new vertex to the planes of the faces its two ends have
 //! absorbed — at the position that minimises it. On top of the textbook method, every collapse
 //! must keep the surface a manifold of unchanged topology (no closed holes, no pinched
-//! vertices, no duplicate faces), may not rotate a face normal by more than a set angle (no
-//! fold-overs) and may not create needles; open boundaries are held in place by penalty planes
-//! perpendicular to their faces, so the holes of a scan keep their outline.
+//! vertices, no duplicate faces), may not rotate a face normal by more than a set angle nor
+//! turn a face against its input normal (no fold-overs), may not create needles and may not
+//! give a vertex more neighbours than subdivision evaluates well; open boundaries are held in
+//! place by penalty planes perpendicular to their faces, so the holes of a scan keep their
+//! outline.
+//!
+//! The input is repaired first ([`crate::mesh::repair`]) and its polygons fan-triangulated, so
+//! any mesh goes in. When the shape guards leave no valid collapse above the target they are
+//! relaxed step by step (recorded in [`SimplifyReport::relaxations`]); the only floor is the
+//! topology (a closed component keeps at least 4 vertices, a boundary loop at least 3), and a
+//! target below it gives the floor, with [`SimplifyReport::floor_note`] saying so.
+//!
+//! Collapses are made in passes rather than from a priority queue (see the `engine` module):
+//! about 2 M triangles per second on one core, in about 150 bytes per input triangle.
 //!
 //! ```
 //! use geofit::geom::Point3;
@@ -34,24 +45,23 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-mod collapse;
+mod check;
 mod deviation;
+mod engine;
 mod error;
-mod incidence;
 mod locality;
 mod quadric;
-mod queue;
+mod rank;
+mod verify;
 
-pub use deviation::{deviation, Deviation};
+pub use deviation::{deviation, foldovers, Deviation, Foldovers};
 pub use error::SimplifyError;
 
-use crate::geom::Point3;
+use crate::mesh::repair::{repair, RepairReport};
 use crate::mesh::PolyMesh;
-use collapse::{Limits, Work};
-use incidence::{Incidence, InputEdge};
-use locality::Numbering;
-use quadric::Quadric;
-use queue::{Candidate, Queue};
+use check::Limits;
+use engine::Engine;
+use serde::Serialize;
 
 /// Settings of [`simplify_with`]. Build with `SimplifyOptions::default()` and the `with_*`
 /// setters.
@@ -71,6 +81,11 @@ pub struct SimplifyOptions {
     /// Smallest triangle quality (4√3·area / Σ edge², 1 = equilateral) a collapse may create,
     /// unless its neighbourhood already had a worse triangle. Default 0.1: no needles.
     pub min_triangle_quality: f64,
+    /// Largest valence (number of neighbours) a collapse may give a vertex, unless one of the
+    /// edge's ends already had more: subdivision evaluates a patch from at most 64 control
+    /// points, which three corners of valence about 20 already need. Default 16 (never more
+    /// than 3 above the largest valence an input ends with; see the README's QEM figures).
+    pub max_valence: usize,
 }
 
 impl Default for SimplifyOptions {
@@ -79,6 +94,7 @@ impl Default for SimplifyOptions {
             boundary_weight: 10.0,
             max_normal_change_deg: 60.0,
             min_triangle_quality: 0.1,
+            max_valence: 16,
         }
     }
 }
@@ -99,6 +115,12 @@ impl SimplifyOptions {
     /// Sets [`SimplifyOptions::min_triangle_quality`].
     pub fn with_min_triangle_quality(mut self, quality: f64) -> SimplifyOptions {
         self.min_triangle_quality = quality;
+        self
+    }
+
+    /// Sets [`SimplifyOptions::max_valence`].
+    pub fn with_max_valence(mut self, valence: usize) -> SimplifyOptions {
+        self.max_valence = valence;
         self
     }
 
@@ -134,251 +156,268 @@ impl SimplifyOptions {
             q,
             (0.0..1.0).contains(&q),
             "in [0, 1)",
-        )
+        )?;
+        let v = self.max_valence;
+        check("max_valence", v as f64, v >= MIN_VALENCE_CAP, ">= 6")
     }
 
-    fn limits(&self) -> Limits {
-        Limits {
+    /// The limits of the configured options, then the relaxed ones, loosest last.
+    fn stages(&self) -> Vec<Limits> {
+        let first = Limits {
             min_normal_cos: self.max_normal_change_deg.to_radians().cos(),
             min_quality: self.min_triangle_quality,
+            max_valence: self.max_valence,
+            min_reference_cos: REFERENCE_COS,
+        };
+        let mut stages = vec![first];
+        for (degrees, quality) in RELAXED {
+            let next = Limits {
+                min_normal_cos: first.min_normal_cos.min(f64::to_radians(degrees).cos()),
+                min_quality: first.min_quality.min(quality),
+                min_reference_cos: 0.0,
+                ..first
+            };
+            if stages.last() != Some(&next) {
+                stages.push(next);
+            }
         }
+        stages
     }
 }
 
-/// The limits used once the configured ones leave no valid collapse: normals may turn up to
-/// this many degrees (still no flip), and only degenerate slivers are refused.
-const RELAXED_NORMAL_CHANGE_DEG: f64 = 85.0;
-const RELAXED_MIN_QUALITY: f64 = 1e-3;
+/// Cosine of the largest angle (about 75°) between a face and the input it stands for under
+/// the configured limits; the relaxed ones allow up to a right angle, never more.
+const REFERENCE_COS: f64 = 0.25;
 
-/// The smallest target: a tetrahedron is the smallest closed triangle mesh.
-const MIN_TARGET: usize = 4;
+/// The smallest valence cap accepted: a regular interior vertex has 6 neighbours.
+const MIN_VALENCE_CAP: usize = 6;
 
-/// Simplifies `mesh` to a triangle mesh with exactly `target` vertices, with default options.
-/// See [`simplify_with`].
+/// The relaxation steps (largest normal rotation in degrees, smallest triangle quality) used
+/// in turn once the previous limits leave no valid collapse. Even the last refuses faces that
+/// turn by a right angle or more, or against their input normal, and near-degenerate slivers.
+const RELAXED: [(f64, f64); 3] = [(75.0, 0.05), (85.0, 0.01), (89.0, 1e-3)];
+
+/// A relaxation of the shape guards during a simplification.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct Relaxation {
+    /// Vertices left when the previous limits blocked every collapse.
+    pub at_vertices: usize,
+    /// The new largest normal rotation per collapse, in degrees.
+    pub max_normal_change_deg: f64,
+    /// The new smallest triangle quality.
+    pub min_triangle_quality: f64,
+}
+
+/// What a simplification did.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct SimplifyReport {
+    /// The vertex count asked for.
+    pub target: usize,
+    /// The vertex count reached: `target`, unless the mesh allows no fewer (see
+    /// [`SimplifyReport::floor_note`]) or has fewer.
+    pub vertices: usize,
+    /// Triangles of the result.
+    pub triangles: usize,
+    /// Passes of collapses made.
+    pub passes: usize,
+    /// The shape guards relaxed on the way, in order.
+    pub relaxations: Vec<Relaxation>,
+    /// Why the result has more vertices than `target`, when it has.
+    pub floor_note: Option<String>,
+    /// The largest valence of the result.
+    pub max_valence: usize,
+    /// What repairing the (triangulated) input changed.
+    pub repair: RepairReport,
+}
+
+/// A simplified mesh and its report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Simplified {
+    /// The simplified triangle mesh.
+    pub mesh: PolyMesh,
+    /// What was done.
+    pub report: SimplifyReport,
+}
+
+/// Simplifies `mesh` to `target` vertices, with default options. See [`simplify_with_report`].
 pub fn simplify(mesh: &PolyMesh, target: usize) -> Result<PolyMesh, SimplifyError> {
     simplify_with(mesh, target, &SimplifyOptions::default())
 }
 
-/// Simplifies `mesh` to a triangle mesh with exactly `target` vertices.
-///
-/// Polygons are fan-triangulated; degenerate and duplicate faces are dropped, and vertices in
-/// no face are left out of the result (so `target` counts only vertices used by faces). The
-/// output keeps the input's vertex order among the survivors and its face orientation, and is
-/// deterministic. A manifold input gives a manifold output with the same Euler characteristic
-/// and boundary loops; non-manifold places of an input are left as they are.
-///
-/// If the configured limits leave no valid collapse before `target`, they are relaxed once
-/// (normals may turn up to 85°, only degenerate slivers are refused) before giving up with
-/// [`SimplifyError::TargetUnreachable`].
+/// Simplifies `mesh` to `target` vertices. See [`simplify_with_report`].
 pub fn simplify_with(
     mesh: &PolyMesh,
     target: usize,
     options: &SimplifyOptions,
 ) -> Result<PolyMesh, SimplifyError> {
+    Ok(simplify_with_report(mesh, target, options)?.mesh)
+}
+
+/// Simplifies `mesh` to a triangle mesh with `target` vertices, and reports how.
+///
+/// The mesh is fan-triangulated and repaired first ([`crate::mesh::repair`]); vertices in no
+/// face are left out of the result, so `target` counts only vertices of faces. The result is an
+/// oriented manifold with the topology of the repaired input (Euler characteristic, boundary
+/// loops), keeps the input's vertex order among the survivors and its face orientation, and is
+/// deterministic. It has exactly `target` vertices unless the topology allows no fewer (then it
+/// has the fewest it allows, and the report's `floor_note` says why) or the faces have fewer
+/// vertices than `target` (then it has them all).
+pub fn simplify_with_report(
+    mesh: &PolyMesh,
+    target: usize,
+    options: &SimplifyOptions,
+) -> Result<Simplified, SimplifyError> {
     options.validate()?;
-    if let Some(vertex) = mesh.positions().iter().position(|p| !p.is_finite()) {
-        return Err(SimplifyError::NonFiniteVertex { vertex });
-    }
     if mesh.is_point_cloud() {
         return Err(SimplifyError::NoFaces);
     }
-    if target < MIN_TARGET {
-        return Err(SimplifyError::TargetTooSmall {
-            target,
-            min: MIN_TARGET,
+    let (mut engine, repair) = working_mesh(mesh, options.boundary_weight)?;
+    let (passes, relaxations) = reduce(&mut engine, target, &options.stages());
+    let max_valence = engine.max_valence();
+    let live = engine.live();
+    let (positions, tris) = engine.into_parts();
+    let starts = (0..=tris.len() as u32 / 3).map(|f| 3 * f).collect();
+    let mesh = PolyMesh::from_parts_unchecked(positions, starts, tris);
+    let report = SimplifyReport {
+        target,
+        vertices: live,
+        triangles: mesh.num_faces(),
+        passes,
+        relaxations,
+        floor_note: floor_note(&mesh, target),
+        max_valence,
+        repair,
+    };
+    Ok(Simplified { mesh, report })
+}
+
+/// The working mesh of `mesh` (fan-triangulated, and repaired unless it is clean already) and
+/// the repair's report.
+fn working_mesh(
+    mesh: &PolyMesh,
+    boundary_weight: f64,
+) -> Result<(Engine, RepairReport), SimplifyError> {
+    let triangles = triangulated(mesh);
+    let (_, idx) = triangles.raw_faces();
+    let engine = Engine::new(
+        triangles.positions().to_vec(),
+        idx.to_vec(),
+        boundary_weight,
+    );
+    if let Some(report) = verify::clean_report(&engine) {
+        return Ok((engine, report));
+    }
+    drop(engine);
+    let repaired = repair(&triangles)?;
+    let (pos, _, tris) = repaired.mesh.into_parts();
+    if tris.is_empty() {
+        return Err(SimplifyError::NoFaces);
+    }
+    Ok((Engine::new(pos, tris, boundary_weight), repaired.report))
+}
+
+/// `mesh` with its polygons fan-triangulated (the mesh itself when it has only triangles).
+fn triangulated(mesh: &PolyMesh) -> std::borrow::Cow<'_, PolyMesh> {
+    if mesh.faces().all(|f| f.len() == 3) {
+        return std::borrow::Cow::Borrowed(mesh);
+    }
+    let tris = mesh.triangles();
+    let starts = (0..=tris.len() as u32).map(|f| 3 * f).collect();
+    let idx = tris.into_iter().flatten().collect();
+    std::borrow::Cow::Owned(PolyMesh::from_parts_unchecked(
+        mesh.positions().to_vec(),
+        starts,
+        idx,
+    ))
+}
+
+/// Passes of collapses until `target` vertices are left or the loosest of `stages` leaves no
+/// valid collapse; returns the number of passes and the relaxations made.
+fn reduce(engine: &mut Engine, target: usize, stages: &[Limits]) -> (usize, Vec<Relaxation>) {
+    let mut stage = 0;
+    let mut passes = 0;
+    let mut relaxations = Vec::new();
+    while engine.live() > target {
+        passes += 1;
+        if engine.pass(target, &stages[stage]) > 0 {
+            continue;
+        }
+        stage += 1;
+        let Some(limits) = stages.get(stage) else {
+            break;
+        };
+        relaxations.push(Relaxation {
+            at_vertices: engine.live(),
+            max_normal_change_deg: limits.min_normal_cos.clamp(-1.0, 1.0).acos().to_degrees(),
+            min_triangle_quality: limits.min_quality,
         });
     }
-    let pos = mesh.positions();
-    let tris = clean_triangles(mesh);
-    let incidence = Incidence::new(pos.len(), &tris);
-    let available = incidence.used_vertices();
-    if target > available {
-        return Err(SimplifyError::TargetTooLarge { target, available });
-    }
-    let edges = incidence.edges(&tris);
-    let quadric = quadrics(pos, &tris, &edges, options.boundary_weight);
-    let numbering = Numbering::spatial(pos, &tris);
-    let mut work = Work::new(pos, &tris, &incidence, &edges, &quadric, numbering);
-    reduce(&mut work, target, options)?;
-    output(&work)
+    (passes, relaxations)
 }
 
-/// The mesh's triangles without degenerate (repeated-index) or duplicate faces, in input order.
-fn clean_triangles(mesh: &PolyMesh) -> Vec<[u32; 3]> {
-    let tris: Vec<[u32; 3]> = mesh
-        .triangles()
-        .into_iter()
-        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
-        .collect();
-    let mut keyed: Vec<([u32; 3], usize)> = tris
-        .iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let mut k = *t;
-            k.sort_unstable();
-            (k, i)
-        })
-        .collect();
-    keyed.sort_unstable();
-    let mut keep = vec![true; tris.len()];
-    for w in keyed.windows(2) {
-        if w[0].0 == w[1].0 {
-            keep[w[1].1] = false;
-        }
+/// Why `mesh` has more vertices than `target`, if it has.
+fn floor_note(mesh: &PolyMesh, target: usize) -> Option<String> {
+    let v = mesh.num_vertices();
+    if v <= target {
+        return None;
     }
-    tris.into_iter()
-        .zip(keep)
-        .filter_map(|(t, k)| k.then_some(t))
-        .collect()
+    let t = topology(mesh);
+    Some(format!(
+        "target {target} is below what this mesh allows: stopped at {v} vertices, where no \
+         collapse keeps its topology ({} components, Euler characteristic {}, {} boundary \
+         loops) without folding the surface",
+        t.components, t.euler, t.boundary_loops
+    ))
 }
 
-/// Area-weighted face-plane quadrics at every vertex, plus penalty planes along the edges
-/// with one face (in input order: the sums, and so the result, do not depend on the working
-/// numbering).
-fn quadrics(
-    pos: &[Point3],
-    tris: &[[u32; 3]],
-    edges: &[InputEdge],
-    boundary_weight: f64,
-) -> Vec<Quadric> {
-    let mut quadric = vec![Quadric::default(); pos.len()];
-    for t in tris {
-        let p = t.map(|i| pos[i as usize]);
-        let n = (p[1] - p[0]).cross(p[2] - p[0]);
-        let q = Quadric::plane(n.normalize_or_zero(), p[0], 0.5 * n.length());
-        for &v in t {
-            quadric[v as usize] += q;
-        }
-    }
-    if boundary_weight == 0.0 {
-        return quadric;
-    }
-    for &InputEdge { a, b, face, .. } in edges.iter().filter(|e| e.faces == 1) {
-        let t = tris[face as usize].map(|v| pos[v as usize]);
-        let face_normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-        let (pa, pb) = (pos[a as usize], pos[b as usize]);
-        let normal = (pb - pa).cross(face_normal).normalize_or_zero();
-        let q = Quadric::plane(normal, pa, boundary_weight * pa.distance_squared(pb));
-        quadric[a as usize] += q;
-        quadric[b as usize] += q;
-    }
-    quadric
+/// Components, Euler characteristic and boundary loops of a small manifold triangle mesh.
+struct Topology {
+    components: usize,
+    euler: i64,
+    boundary_loops: usize,
 }
 
-/// How far (in edge lengths from the edge midpoint) the quadric's optimum may lie before it is
-/// distrusted as the product of a nearly singular system.
-const MAX_OPTIMUM_OFFSET: f64 = 2.0;
-
-/// The best position for the vertex that replaces edge `u`–`v`, and its quadric error: the
-/// optimum of the summed quadric when it is well defined, else the best of the end points, the
-/// midpoint and the optimum along the edge.
-fn placement(work: &Work, u: u32, v: u32) -> (Point3, f64) {
-    let q = work.quadric[u as usize] + work.quadric[v as usize];
-    let (pu, pv) = (work.pos[u as usize], work.pos[v as usize]);
-    let mid = (pu + pv) * 0.5;
-    let optimum = q
-        .minimizer()
-        .filter(|x| x.distance(mid) <= MAX_OPTIMUM_OFFSET * pu.distance(pv));
-    let target = optimum.unwrap_or_else(|| {
-        let on_segment = q.minimizer_on_segment(pu, pv);
-        [pu, pv, mid, on_segment]
-            .into_iter()
-            .min_by(|a, b| q.eval(*a).total_cmp(&q.eval(*b)))
-            .unwrap_or(mid)
-    });
-    (target, q.eval(target))
-}
-
-/// Edge `edge` as a queue entry (ordered by input indices); its collapse position goes to
-/// `targets`.
-fn candidate(work: &Work, edge: u32, targets: &mut [Point3]) -> Candidate {
-    let (u, v) = work.edge_ends(edge);
-    let (target, cost) = placement(work, u, v);
-    targets[edge as usize] = target;
-    let input = &work.numbering.vertex_input;
-    Candidate {
-        cost,
-        u: input[u as usize],
-        v: input[v as usize],
-        edge,
+fn topology(mesh: &PolyMesh) -> Topology {
+    let n = mesh.num_vertices();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
     }
-}
-
-/// Every edge of the current mesh, queued.
-fn all_candidates(work: &Work, targets: &mut [Point3]) -> Queue {
-    let mut items = Vec::new();
-    for (v, links) in work.adj.iter().enumerate() {
-        for l in links.iter().filter(|l| l.nbr > v as u32) {
-            items.push(candidate(work, l.edge, targets));
+    let mut edges = std::collections::BTreeMap::new();
+    for f in mesh.faces() {
+        for k in 0..f.len() {
+            let (a, b) = (f[k], f[(k + 1) % f.len()]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0usize) += 1;
+            let (ra, rb) = (root(&mut parent, a as usize), root(&mut parent, b as usize));
+            parent[ra] = rb;
         }
     }
-    Queue::new(work.ends.len(), items)
-}
-
-/// Collapses edges until `target` vertices are left.
-fn reduce(work: &mut Work, target: usize, options: &SimplifyOptions) -> Result<(), SimplifyError> {
-    let mut limits = options.limits();
-    let mut relaxed = false;
-    // Where each edge would collapse to, for its queued cost.
-    let mut targets = vec![Point3::ZERO; work.ends.len()];
-    let mut heap = all_candidates(work, &mut targets);
-    let mut removed = Vec::new();
-    let mut progress_since_rebuild = false;
-    while work.live > target {
-        let Some(c) = heap.pop() else {
-            if !progress_since_rebuild {
-                if relaxed {
-                    return Err(SimplifyError::TargetUnreachable {
-                        target,
-                        reached: work.live,
-                    });
-                }
-                relaxed = true;
-                limits = Limits {
-                    min_normal_cos: RELAXED_NORMAL_CHANGE_DEG.to_radians().cos(),
-                    min_quality: RELAXED_MIN_QUALITY.min(limits.min_quality),
-                };
-            }
-            // Collapses refused earlier may have become valid as their neighbourhood changed.
-            heap = all_candidates(work, &mut targets);
-            progress_since_rebuild = false;
-            continue;
-        };
-        // A refused edge stays out of the queue until a collapse at one of its ends re-costs it.
-        let p = targets[c.edge as usize];
-        let (u, v) = work.edge_ends(c.edge);
-        if !work.allows(u, v, p, &limits) {
-            continue;
-        }
-        removed.clear();
-        work.collapse(u, v, p, &mut removed);
-        progress_since_rebuild = true;
-        for &e in &removed {
-            heap.remove(e);
-        }
-        for l in &work.adj[u as usize] {
-            heap.set(candidate(work, l.edge, &mut targets));
-        }
+    let components = (0..n).filter(|&v| root(&mut parent, v) == v).count();
+    // Boundary loops: components of the graph of boundary edges (each boundary vertex of a
+    // manifold has two boundary edges, so each component is one loop).
+    let mut loop_parent: Vec<usize> = (0..n).collect();
+    let mut on_boundary = vec![false; n];
+    for (&(a, b), _) in edges.iter().filter(|(_, &c)| c == 1) {
+        on_boundary[a as usize] = true;
+        on_boundary[b as usize] = true;
+        let (ra, rb) = (
+            root(&mut loop_parent, a as usize),
+            root(&mut loop_parent, b as usize),
+        );
+        loop_parent[ra] = rb;
     }
-    Ok(())
-}
-
-/// The surviving vertices and faces, in input order, as a [`PolyMesh`].
-fn output(work: &Work) -> Result<PolyMesh, SimplifyError> {
-    let numbering = &work.numbering;
-    let mut remap = vec![u32::MAX; work.pos.len()];
-    let mut positions = Vec::with_capacity(work.live);
-    for &v in &numbering.vertex_work {
-        if !work.vfaces[v as usize].is_empty() {
-            remap[v as usize] = positions.len() as u32;
-            positions.push(work.pos[v as usize]);
-        }
+    let boundary_loops = (0..n)
+        .filter(|&v| on_boundary[v] && root(&mut loop_parent, v) == v)
+        .count();
+    Topology {
+        components,
+        euler: n as i64 - edges.len() as i64 + mesh.num_faces() as i64,
+        boundary_loops,
     }
-    let faces: Vec<[u32; 3]> = numbering
-        .face_work
-        .iter()
-        .filter(|&&f| work.tri_alive[f as usize])
-        .map(|&f| work.faces[f as usize].corners.map(|v| remap[v as usize]))
-        .collect();
-    Ok(PolyMesh::try_new(positions, faces)?)
 }

@@ -2,7 +2,6 @@
 //! stored as the symmetric form Q(x) = xᵀAx + 2bᵀx + c.
 
 use crate::geom::{Point3, Vec3};
-use glam::DMat3;
 use std::ops::AddAssign;
 
 /// A symmetric 4×4 error quadric (10 coefficients).
@@ -39,57 +38,81 @@ impl Quadric {
         }
     }
 
-    fn matrix(&self) -> DMat3 {
-        DMat3::from_cols_array(&[
-            self.a00, self.a01, self.a02, self.a01, self.a11, self.a12, self.a02, self.a12,
-            self.a22,
-        ])
+    /// `A v`.
+    fn mul(&self, v: Vec3) -> Vec3 {
+        Vec3::new(
+            self.a00 * v.x + self.a01 * v.y + self.a02 * v.z,
+            self.a01 * v.x + self.a11 * v.y + self.a12 * v.z,
+            self.a02 * v.x + self.a12 * v.y + self.a22 * v.z,
+        )
     }
 
-    /// The error at `p`; never negative (rounding is clamped).
+    /// The error at `p`; never negative (rounding is clamped). Written out, as the simplifier
+    /// evaluates it for every edge in every pass.
     pub(super) fn eval(&self, p: Point3) -> f64 {
-        let ap = self.matrix() * p;
-        (p.dot(ap) + 2.0 * self.b.dot(p) + self.c).max(0.0)
+        let (x, y, z) = (p.x, p.y, p.z);
+        let quadratic = self.a00 * x * x
+            + self.a11 * y * y
+            + self.a22 * z * z
+            + 2.0 * (self.a01 * x * y + self.a02 * x * z + self.a12 * y * z);
+        (quadratic + 2.0 * self.b.dot(p) + self.c).max(0.0)
     }
 
-    /// The point minimising the error, or `None` when A is (nearly) singular. Solved by
-    /// cofactors (what `DMat3::inverse` does, computed once for the singularity test too).
+    /// The point minimising the error, or `None` when A is (nearly) singular: `-A⁻¹b` from the
+    /// six cofactors of the symmetric A, whose determinant also serves the singularity test.
     pub(super) fn minimizer(&self) -> Option<Point3> {
-        let a = self.matrix();
-        let cof = [
-            a.y_axis.cross(a.z_axis),
-            a.z_axis.cross(a.x_axis),
-            a.x_axis.cross(a.y_axis),
-        ];
-        let det = a.x_axis.dot(cof[0]);
-        let norm_sq = [self.a00, self.a11, self.a22]
-            .iter()
-            .map(|v| v * v)
-            .sum::<f64>()
-            + 2.0 * (self.a01 * self.a01 + self.a02 * self.a02 + self.a12 * self.a12);
-        let scale = norm_sq * norm_sq.sqrt();
-        if det.is_nan() || det.abs() <= SINGULAR_RATIO * scale {
+        let (a00, a01, a02, a11, a12, a22) =
+            (self.a00, self.a01, self.a02, self.a11, self.a12, self.a22);
+        let c00 = a11 * a22 - a12 * a12;
+        let c01 = a02 * a12 - a01 * a22;
+        let c02 = a01 * a12 - a02 * a11;
+        let det = a00 * c00 + a01 * c01 + a02 * c02;
+        let norm_sq = a00 * a00 + a11 * a11 + a22 * a22 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12);
+        if det.is_nan() || det.abs() <= SINGULAR_RATIO * norm_sq * norm_sq.sqrt() {
             return None;
         }
-        let inv_det = 1.0 / det;
-        let inverse = DMat3::from_cols(cof[0] * inv_det, cof[1] * inv_det, cof[2] * inv_det);
-        let x = inverse.transpose() * (-self.b);
+        let c11 = a00 * a22 - a02 * a02;
+        let c12 = a01 * a02 - a00 * a12;
+        let c22 = a00 * a11 - a01 * a01;
+        let b = self.b;
+        let x = Point3::new(
+            c00 * b.x + c01 * b.y + c02 * b.z,
+            c01 * b.x + c11 * b.y + c12 * b.z,
+            c02 * b.x + c12 * b.y + c22 * b.z,
+        ) * (-1.0 / det);
         x.is_finite().then_some(x)
     }
 
-    /// The point minimising the error on the segment `p`–`q` (closed form of a 1D quadratic).
+    /// The point minimising the error on the segment `p`–`q` (closed form of a 1D quadratic;
+    /// along a direction of no curvature, the lower end).
     pub(super) fn minimizer_on_segment(&self, p: Point3, q: Point3) -> Point3 {
         let d = q - p;
-        let a = self.matrix();
         // Q(p + t d) = t² dᵀAd + 2t (dᵀAp + bᵀd) + const.
-        let curv = d.dot(a * d);
-        let slope = d.dot(a * p) + self.b.dot(d);
+        let curv = d.dot(self.mul(d));
+        let slope = d.dot(self.mul(p)) + self.b.dot(d);
         if curv.is_nan() || curv <= 0.0 {
-            return p;
+            return if slope < 0.0 { q } else { p };
         }
         let t = (-slope / curv).clamp(0.0, 1.0);
         p + d * t
     }
+}
+
+/// How far (in edge lengths from the edge midpoint) the quadric's optimum may lie before it is
+/// distrusted as the product of a nearly singular system.
+const MAX_OPTIMUM_OFFSET: f64 = 2.0;
+
+/// The best position for the vertex that replaces edge `pu`–`pv` under the summed quadric `q`,
+/// and its error: the optimum of `q` when it is well defined and near the edge, else the
+/// optimum on the edge.
+pub(super) fn placement(q: &Quadric, pu: Point3, pv: Point3) -> (Point3, f64) {
+    let mid = (pu + pv) * 0.5;
+    let reach_sq = MAX_OPTIMUM_OFFSET * MAX_OPTIMUM_OFFSET * pu.distance_squared(pv);
+    let optimum = q
+        .minimizer()
+        .filter(|x| x.distance_squared(mid) <= reach_sq);
+    let target = optimum.unwrap_or_else(|| q.minimizer_on_segment(pu, pv));
+    (target, q.eval(target))
 }
 
 impl AddAssign for Quadric {

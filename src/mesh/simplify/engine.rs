@@ -1,0 +1,485 @@
+//! The simplifier's working mesh and its passes of edge collapses.
+//!
+//! No priority queue. Each pass costs every edge once and then collapses, in *waves*, the
+//! edges that are the cheapest at both their ends among those still open; an end that took
+//! part in a collapse is locked until the next pass. The waves of a pass take what a walk
+//! through its edges in cost order would (meshoptimizer's scheme, which sorts instead), but a
+//! wave's picks share no vertex and are tried in face order, which the spatial numbering of
+//! the `locality` module makes an order through memory. Locking keeps the costs of a pass
+//! exact (they depend only on the two ends' quadrics and positions), while the collapse test
+//! always reads the mesh as it is now: the faces of each vertex are indexed once per pass, a
+//! face changed by a collapse of this pass is read through `remap` (a merged vertex points at
+//! the vertex it went into, never further, since that one is locked), and the face list is
+//! compacted at the end of the pass.
+//!
+//! A pass takes only collapses up to 1.5 times the cost of the `n`-th cheapest edge, where
+//! `n` is the number of collapses still needed (or up to the dearest collapse made so far):
+//! cheap collapses come first across passes too. When that leaves it with too little, it takes
+//! any valid collapse.
+
+use super::check::{Corner, Limits, Ring};
+use super::locality::Numbering;
+use super::quadric::{placement, Quadric};
+use super::rank::cost_at_rank;
+use crate::geom::{Point3, Vec3};
+
+/// Below this share of the collapses still needed, a pass does not stop for cost (passes on
+/// meshes of odd topology, where most collapses are refused, still make progress).
+const MIN_PASS_SHARE: usize = 6;
+
+/// How much dearer than the pass's cost goal a collapse may be (see the module docs).
+const GOAL_FACTOR: f64 = 1.5;
+
+/// Waves of a pass: most of what a pass can take comes in the first few; the rest is left to
+/// the next pass, which costs its edges anew.
+const MAX_WAVES: usize = 8;
+
+/// A wave that tries fewer than one in this many open candidates ends the pass's waves.
+const MIN_WAVE_SHARE: usize = 1000;
+
+/// A collapse of edge `a`–`b` (`a < b`) at its cost; NaN once refused.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    a: u32,
+    b: u32,
+    cost: f64,
+}
+
+/// A triangle of the working mesh with the area-weighted normal of the input it stands for:
+/// its own input triangle's, plus shares of the faces that collapses removed next to it. A
+/// face may never turn against it, which catches fold-overs built up by many small rotations
+/// and faces that end up facing away from the surface they replace. One record, as the
+/// collapse test reads both for every face around an edge.
+#[derive(Clone, Copy, Debug)]
+struct Face {
+    v: [u32; 3],
+    normal: Vec3,
+}
+
+/// The mesh being simplified: an oriented manifold triangle mesh with boundary.
+pub(super) struct Engine {
+    pos: Vec<Point3>,
+    quadric: Vec<Quadric>,
+
+    /// Live triangles, in spatial order.
+    tris: Vec<Face>,
+    /// Whether each vertex has an edge with one face.
+    boundary: Vec<bool>,
+    /// Faces of vertex `v` at the start of the pass: `faces[start[v]..start[v + 1]]`.
+    start: Vec<u32>,
+    faces: Vec<u32>,
+    /// Faces each vertex has now.
+    face_count: Vec<u32>,
+    /// The vertex each vertex was merged into in this pass (itself if none).
+    remap: Vec<u32>,
+    /// Whether each vertex took part in a collapse in this pass.
+    locked: Vec<bool>,
+    /// Vertices with at least one face.
+    live: usize,
+    /// Largest cost of any collapse made.
+    worst: f64,
+    /// The wave under way (see [`Engine::waves`]), counted over all passes.
+    wave: u64,
+    /// The cheapest candidate of each vertex in a wave: the wave in the high 32 bits, the
+    /// candidate's index in the low ones.
+    cheapest: Vec<u64>,
+    ring: Ring,
+    /// How working indices relate to the input's.
+    numbering: Numbering,
+}
+
+impl Engine {
+    /// The working mesh of `pos` and the triangles `tris` (an oriented manifold with
+    /// boundary), with `boundary_weight` for the penalty planes along open edges.
+    pub(super) fn new(pos: Vec<Point3>, tris: Vec<u32>, boundary_weight: f64) -> Engine {
+        let n = pos.len();
+        let numbering = Numbering::spatial(&pos);
+        let (pos, tris) = numbering.apply(pos, tris);
+        let tris: Vec<Face> = tris
+            .chunks_exact(3)
+            .map(|t| {
+                let v = [t[0], t[1], t[2]];
+                let [a, b, c] = v.map(|v| pos[v as usize]);
+                let normal = 0.5 * (b - a).cross(c - a);
+                Face { v, normal }
+            })
+            .collect();
+        let mut e = Engine {
+            quadric: Vec::new(),
+            pos,
+            tris,
+            boundary: vec![false; n],
+            start: Vec::new(),
+            faces: Vec::new(),
+            face_count: vec![0; n],
+            remap: (0..n as u32).collect(),
+            locked: vec![false; n],
+            live: 0,
+            worst: 0.0,
+            wave: 0,
+            cheapest: vec![0; n],
+            ring: Ring::default(),
+            numbering,
+        };
+        e.index_faces();
+        e.live = e.face_count.iter().filter(|&&c| c > 0).count();
+        e.quadric = e.quadrics(boundary_weight);
+        e
+    }
+
+    /// Vertices with at least one face.
+    pub(super) fn live(&self) -> usize {
+        self.live
+    }
+
+    /// Position of `v`.
+    pub(super) fn pos(&self, v: u32) -> Point3 {
+        self.pos[v as usize]
+    }
+
+    /// Faces `v` has now.
+    pub(super) fn face_count(&self, v: u32) -> u32 {
+        self.face_count[v as usize]
+    }
+
+    /// Whether `v` is on an open boundary.
+    pub(super) fn is_boundary(&self, v: u32) -> bool {
+        self.boundary[v as usize]
+    }
+
+    /// Number of vertices, with or without faces.
+    pub(super) fn num_vertices(&self) -> usize {
+        self.pos.len()
+    }
+
+    /// Number of live faces.
+    pub(super) fn num_faces(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// The corners of face `f`.
+    pub(super) fn face(&self, f: usize) -> [u32; 3] {
+        self.tris[f].v
+    }
+
+    /// Input indices of the vertices in no face, in order.
+    pub(super) fn unreferenced_inputs(&self) -> impl Iterator<Item = usize> + '_ {
+        let work = &self.numbering.work;
+        (0..work.len()).filter(move |&v| self.face_count[work[v] as usize] == 0)
+    }
+
+    /// The faces `v` had at the start of the pass.
+    pub(super) fn faces_of(&self, v: u32) -> &[u32] {
+        let v = v as usize;
+        &self.faces[self.start[v] as usize..self.start[v + 1] as usize]
+    }
+
+    /// Appends the faces of `v` (an unlocked vertex) as they are now, seen from `v`, with
+    /// merged corners renamed; faces that a collapse in this pass removed are left out.
+    pub(super) fn live_corners(&self, v: u32, out: &mut Vec<Corner>) {
+        for &f in self.faces_of(v) {
+            let face = &self.tris[f as usize];
+            let t = face.v;
+            let k = if t[0] == v {
+                0
+            } else if t[1] == v {
+                1
+            } else {
+                2
+            };
+            let next = self.remap[t[(k + 1) % 3] as usize];
+            let prev = self.remap[t[(k + 2) % 3] as usize];
+            if next != prev {
+                out.push(Corner {
+                    face: f,
+                    next,
+                    prev,
+                    normal: face.normal,
+                });
+            }
+        }
+    }
+
+    /// Indexes the faces of every vertex, finds the boundary vertices and resets the pass
+    /// state (merges, locks).
+    ///
+    /// Around a vertex of a manifold the faces form one fan, in which each face's next corner
+    /// is the following face's previous one; so the sum of next minus previous corners over
+    /// the vertex's faces is 0 for a closed fan and the difference of the two (distinct)
+    /// boundary neighbours for an open one: an exact boundary test with no sorting.
+    fn index_faces(&mut self) {
+        let n = self.pos.len();
+        self.start.clear();
+        self.start.resize(n + 1, 0);
+        let mut turn = vec![0i64; n];
+        for f in &self.tris {
+            let t = f.v;
+            for k in 0..3 {
+                let (v, next, prev) = (t[k] as usize, t[(k + 1) % 3], t[(k + 2) % 3]);
+                self.start[v + 1] += 1;
+                turn[v] += i64::from(next) - i64::from(prev);
+            }
+        }
+        for (b, s) in self.boundary.iter_mut().zip(turn) {
+            *b = s != 0;
+        }
+        for v in 0..n {
+            self.face_count[v] = self.start[v + 1];
+            self.start[v + 1] += self.start[v];
+        }
+        self.faces.resize(3 * self.tris.len(), 0);
+        let mut fill = std::mem::take(&mut self.remap);
+        fill.copy_from_slice(&self.start[..n]);
+        for (k, f) in self.tris.iter().enumerate() {
+            for &v in &f.v {
+                self.faces[fill[v as usize] as usize] = k as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        for (v, r) in fill.iter_mut().enumerate() {
+            *r = v as u32;
+        }
+        self.remap = fill;
+        self.locked.fill(false);
+    }
+
+    /// Whether side `x`→`y` of a face is on an open boundary: no face has `y`→`x`. Only
+    /// sides between two boundary vertices can be.
+    fn is_open_side(&self, x: u32, y: u32) -> bool {
+        self.boundary[x as usize] && self.boundary[y as usize] && !self.has_side(y, x)
+    }
+
+    /// Whether a face has the side running from `x` to `y`.
+    fn has_side(&self, x: u32, y: u32) -> bool {
+        self.faces_of(x).iter().any(|&f| {
+            let t = self.tris[f as usize].v;
+            (0..3).any(|k| t[k] == x && t[(k + 1) % 3] == y)
+        })
+    }
+
+    /// Area-weighted face-plane quadrics at every vertex, plus a penalty plane along each open
+    /// edge, perpendicular to its face and weighted by `boundary_weight` times its squared
+    /// length (so open boundaries keep their outline).
+    fn quadrics(&self, boundary_weight: f64) -> Vec<Quadric> {
+        let mut quadric = vec![Quadric::default(); self.pos.len()];
+        for f in &self.tris {
+            let t = f.v;
+            let [a, b, c] = t.map(|v| self.pos(v));
+            let n = (b - a).cross(c - a);
+            let q = Quadric::plane(n.normalize_or_zero(), a, 0.5 * n.length());
+            for v in t {
+                quadric[v as usize] += q;
+            }
+            if boundary_weight == 0.0 {
+                continue;
+            }
+            for k in 0..3 {
+                let (x, y) = (t[k], t[(k + 1) % 3]);
+                if self.is_open_side(x, y) {
+                    let (px, py) = (self.pos(x), self.pos(y));
+                    let side = (py - px).cross(n).normalize_or_zero();
+                    let q = Quadric::plane(side, px, boundary_weight * px.distance_squared(py));
+                    quadric[x as usize] += q;
+                    quadric[y as usize] += q;
+                }
+            }
+        }
+        quadric
+    }
+
+    /// One pass of collapses towards `target` within `limits`; returns how many were made
+    /// (none only when no edge could be collapsed).
+    pub(super) fn pass(&mut self, target: usize, limits: &Limits) -> usize {
+        let mut dear = self.candidates();
+        let needed = self.live.saturating_sub(target);
+        let enough = needed / MIN_PASS_SHARE;
+        let goal = GOAL_FACTOR * cost_at_rank(dear.iter().map(|c| c.cost), needed);
+        let mut threshold = goal.max(self.worst);
+        let mut open = Vec::new();
+        let mut done = 0;
+        loop {
+            // The waves see the candidates up to the threshold; the dearer ones wait.
+            dear.retain(|&c| {
+                let ends_open = !self.locked[c.a as usize] && !self.locked[c.b as usize];
+                if ends_open && c.cost <= threshold {
+                    open.push(c);
+                }
+                ends_open && c.cost > threshold
+            });
+            done += self.waves(&mut open, target, limits);
+            if done > enough || self.live <= target || dear.is_empty() {
+                break;
+            }
+            // Too little within the goal (most collapses refused): admit about as many more
+            // candidates as the pass still lacks, cheapest first.
+            let lacking = enough + 1 - done;
+            threshold = cost_at_rank(dear.iter().map(|c| c.cost), lacking.min(dear.len() - 1));
+        }
+        self.compact();
+        self.index_faces();
+        done
+    }
+
+    /// Every edge once, costed: from the face side that runs from its lower end, or from its
+    /// only side on a boundary.
+    fn candidates(&self) -> Vec<Candidate> {
+        let mut out = Vec::with_capacity(3 * self.tris.len() / 2 + 1);
+        for f in &self.tris {
+            let t = f.v;
+            for k in 0..3 {
+                let (x, y) = (t[k], t[(k + 1) % 3]);
+                if x < y || self.is_open_side(x, y) {
+                    let (a, b) = (x.min(y), x.max(y));
+                    let q = self.quadric[a as usize] + self.quadric[b as usize];
+                    let (_, cost) = placement(&q, self.pos(a), self.pos(b));
+                    out.push(Candidate { a, b, cost });
+                }
+            }
+        }
+        out
+    }
+
+    /// Collapses, in waves, the candidates that are the cheapest at both their ends among
+    /// those still open (ends unlocked, not refused). A wave's picks share no vertex and are
+    /// tried in face order; a refused candidate gets a NaN cost and is out of the pass.
+    /// Returns the collapses made.
+    fn waves(&mut self, cands: &mut Vec<Candidate>, target: usize, limits: &Limits) -> usize {
+        let mut ring = std::mem::take(&mut self.ring);
+        let mut done = 0;
+        for _ in 0..MAX_WAVES {
+            self.mark_cheapest(cands);
+            let stamp = self.wave << 32;
+            let mut tried = 0;
+            for i in 0..cands.len() {
+                let c = cands[i];
+                let mine = |end: u32| self.cheapest[end as usize] == stamp | i as u64;
+                if !mine(c.a) || !mine(c.b) {
+                    continue;
+                }
+                tried += 1;
+                if !self.try_collapse(&mut ring, c.a, c.b, limits) {
+                    cands[i].cost = f64::NAN;
+                    continue;
+                }
+                done += 1;
+                self.worst = self.worst.max(c.cost);
+                if self.live <= target {
+                    self.ring = ring;
+                    return done;
+                }
+            }
+            // A wave that finds little to take leaves the rest to the next pass.
+            if tried * MIN_WAVE_SHARE < cands.len() || tried == 0 {
+                break;
+            }
+        }
+        self.ring = ring;
+        done
+    }
+
+    /// Starts a wave: drops the candidates that are out of the pass (refused, or an end
+    /// locked) and marks in `cheapest` the cheapest candidate at each vertex (ties to the
+    /// lower index), stamped with the wave.
+    fn mark_cheapest(&mut self, cands: &mut Vec<Candidate>) {
+        self.wave += 1;
+        let stamp = self.wave << 32;
+        let mut kept = 0;
+        for i in 0..cands.len() {
+            let c = cands[i];
+            if c.cost.is_nan() || self.locked[c.a as usize] || self.locked[c.b as usize] {
+                continue;
+            }
+            cands[kept] = c;
+            for end in [c.a, c.b] {
+                let slot = &mut self.cheapest[end as usize];
+                if *slot >> 32 != self.wave || cands[(*slot & 0xffff_ffff) as usize].cost > c.cost {
+                    *slot = stamp | kept as u64;
+                }
+            }
+            kept += 1;
+        }
+        cands.truncate(kept);
+    }
+
+    /// Collapses `a`–`b` if the collapse test allows it.
+    fn try_collapse(&mut self, ring: &mut Ring, a: u32, b: u32, limits: &Limits) -> bool {
+        ring.gather(self, a, b);
+        if !ring.topology_allows(self, a, b) || !ring.valence_allows(limits.max_valence) {
+            return false;
+        }
+        let q = self.quadric[a as usize] + self.quadric[b as usize];
+        let (p, _) = placement(&q, self.pos(a), self.pos(b));
+        if !ring.geometry_allows(self, a, b, p, limits) {
+            return false;
+        }
+        self.merge(ring, a, b, p, q);
+        true
+    }
+
+    /// Merges `b` into `a`, which moves to `p` and takes the summed quadric `q`.
+    fn merge(&mut self, ring: &Ring, a: u32, b: u32, p: Point3, q: Quadric) {
+        let (ai, bi) = (a as usize, b as usize);
+        self.remap[bi] = a;
+        self.pos[ai] = p;
+        self.quadric[ai] = q;
+        self.boundary[ai] |= self.boundary[bi];
+        self.locked[ai] = true;
+        self.locked[bi] = true;
+        self.face_count[ai] = ring.surviving_faces() as u32;
+        self.face_count[bi] = 0;
+        for &w in ring.opposite() {
+            self.face_count[w as usize] -= 1;
+        }
+        for (normal, heirs) in ring.removed_faces(a, b) {
+            let share = normal / heirs.iter().flatten().count().max(1) as f64;
+            for g in heirs.into_iter().flatten() {
+                self.tris[g as usize].normal += share;
+            }
+        }
+        self.live -= 1;
+    }
+
+    /// Renames merged corners and drops the faces the pass removed (order kept).
+    fn compact(&mut self) {
+        let remap = &self.remap;
+        self.tris.retain_mut(|f| {
+            f.v = f.v.map(|w| remap[w as usize]);
+            f.v[0] != f.v[1] && f.v[1] != f.v[2] && f.v[2] != f.v[0]
+        });
+    }
+
+    /// The largest valence of any vertex.
+    pub(super) fn max_valence(&self) -> usize {
+        let mut around = Vec::new();
+        (0..self.pos.len() as u32)
+            .map(|v| {
+                around.clear();
+                for &f in self.faces_of(v) {
+                    around.extend(self.tris[f as usize].v.into_iter().filter(|&w| w != v));
+                }
+                around.sort_unstable();
+                around.dedup();
+                around.len()
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// The used vertices (in input order) and the faces, renumbered to them.
+    pub(super) fn into_parts(self) -> (Vec<Point3>, Vec<u32>) {
+        let mut new = vec![u32::MAX; self.pos.len()];
+        let mut positions = Vec::with_capacity(self.live);
+        for &w in &self.numbering.work {
+            if self.face_count[w as usize] > 0 {
+                new[w as usize] = positions.len() as u32;
+                positions.push(self.pos[w as usize]);
+            }
+        }
+        let tris = self
+            .tris
+            .iter()
+            .flat_map(|f| f.v.map(|v| new[v as usize]))
+            .collect();
+        (positions, tris)
+    }
+}
