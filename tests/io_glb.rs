@@ -185,3 +185,30 @@ fn bad_options_are_typed_errors() {
     let e = to_glb_bytes(&far, &GlbOptions::default()).unwrap_err();
     assert!(matches!(e, WriteError::TooLarge { .. }), "{e}");
 }
+
+#[test]
+fn degenerate_triangles_and_lone_vertices_still_give_unit_normals() {
+    // Triangle 1 is degenerate (a repeated corner), vertex 4 is in no triangle: both would
+    // give a zero normal, which glTF forbids; the writer puts +z there.
+    let mesh = PolyMesh::try_new(
+        vec![
+            Point3::ZERO,
+            Point3::X,
+            Point3::Y,
+            Point3::new(2.0, 2.0, 0.0),
+            Point3::new(5.0, 5.0, 5.0),
+        ],
+        [vec![0, 1, 2], vec![1, 3, 3]],
+    )
+    .expect("mesh");
+    let dev = [0.0, 1.0, -1.0, 0.0, 3.0];
+    let glb = to_glb_bytes(&mesh, &GlbOptions::default().with_deviation(&dev)).expect("glb");
+    save("degenerate.glb", &glb);
+    let doc = json_of(&glb);
+    let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
+    let n = floats(&glb, &doc, attrs["NORMAL"].as_u64().expect("NORMAL") as usize);
+    assert_eq!(&n[12..15], &[0.0, 0.0, 1.0]);
+    for v in n.chunks_exact(3) {
+        assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-6);
+    }
+}

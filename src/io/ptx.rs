@@ -290,7 +290,8 @@ mod tests {
         let f = read(format!("{scan}\n{scan}").as_bytes()).unwrap();
         assert_eq!((f.mesh.num_vertices(), f.scans), (12, Some(2)));
         assert!(f.range_grid.is_none());
-        let e = read(format!("{HEADER}1 0 0\n2 x 0\n").as_bytes()).unwrap_err();
+        let e = read(format!("{HEADER}1 0 0\n2 x 0\n3 0 0\n4 0 0\n5 0 0\n6 0 0\n").as_bytes())
+            .unwrap_err();
         assert_eq!(e.to_string(), "PTX line 12: expected a number, found 'x'");
         let e = read(format!("{HEADER}1 0 0\n").as_bytes()).unwrap_err();
         assert!(
