@@ -52,7 +52,9 @@ fn check(name: &str, format: Format, tol: f64) -> LoadedFile {
         "{name}: triangles"
     );
     let bbox = f.mesh.bbox().expect("points");
-    let size = (point(&e["bbox_max"]) - point(&e["bbox_min"])).length().max(1.0);
+    let size = (point(&e["bbox_max"]) - point(&e["bbox_min"]))
+        .length()
+        .max(1.0);
     let close = |a: Point3, b: Point3, what: &str, scale: f64| {
         assert!(
             (a - b).length() <= tol * size * scale,
@@ -67,13 +69,23 @@ fn check(name: &str, format: Format, tol: f64) -> LoadedFile {
     let sum = p.iter().fold(Point3::ZERO, |s, &q| s + q);
     close(sum, point(&e["sum"]), "coordinate sum", n as f64);
     if let Some(scans) = e.get("scans") {
-        assert_eq!(f.scans, Some(scans.as_u64().expect("scans") as usize), "{name}");
+        assert_eq!(
+            f.scans,
+            Some(scans.as_u64().expect("scans") as usize),
+            "{name}"
+        );
     }
     match e["grid"].as_array() {
         Some(g) => {
-            let grid = f.range_grid.as_ref().unwrap_or_else(|| panic!("{name}: no grid"));
+            let grid = f
+                .range_grid
+                .as_ref()
+                .unwrap_or_else(|| panic!("{name}: no grid"));
             let size = (grid.cols(), grid.rows());
-            let want = (g[0].as_u64().unwrap_or(0) as usize, g[1].as_u64().unwrap_or(0) as usize);
+            let want = (
+                g[0].as_u64().unwrap_or(0) as usize,
+                g[1].as_u64().unwrap_or(0) as usize,
+            );
             assert_eq!(size, want, "{name}: grid size");
             let measured = (0..grid.rows())
                 .flat_map(|r| (0..grid.cols()).map(move |c| (c, r)))
@@ -81,8 +93,13 @@ fn check(name: &str, format: Format, tol: f64) -> LoadedFile {
                 .count();
             assert_eq!(measured, n, "{name}: every point in one grid cell");
             for cell in e["cells"].as_array().expect("cells") {
-                let (c, r) = (cell[0].as_u64().unwrap_or(0) as usize, cell[1].as_u64().unwrap_or(0) as usize);
-                let i = grid.cell(c, r).unwrap_or_else(|| panic!("{name}: cell ({c}, {r}) empty"));
+                let (c, r) = (
+                    cell[0].as_u64().unwrap_or(0) as usize,
+                    cell[1].as_u64().unwrap_or(0) as usize,
+                );
+                let i = grid
+                    .cell(c, r)
+                    .unwrap_or_else(|| panic!("{name}: cell ({c}, {r}) empty"));
                 let want = Point3::new(
                     cell[2].as_f64().unwrap_or(0.0),
                     cell[3].as_f64().unwrap_or(0.0),
@@ -230,17 +247,45 @@ fn damaged_headers_give_typed_errors_at_the_place() {
     let mut las = bytes("bunny.las");
     las[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
     let e = read_bytes(&las, None).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { format: Format::Las, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ReadError::Truncated {
+                format: Format::Las,
+                ..
+            }
+        ),
+        "{e}"
+    );
     // LAZ: point count beyond what the compressed bytes can hold.
     let mut laz = bytes("bunny.laz");
     laz[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
     let e = read_bytes(&laz, None).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { format: Format::Laz, at: Location::Byte(107), .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ReadError::Truncated {
+                format: Format::Laz,
+                at: Location::Byte(107),
+                ..
+            }
+        ),
+        "{e}"
+    );
     // E57: the XML section claims to be longer than the file.
     let mut e57 = bytes("bun000-grid.e57");
     e57[32..40].copy_from_slice(&(1u64 << 40).to_le_bytes());
     let e = read_bytes(&e57, None).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { format: Format::E57, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ReadError::Truncated {
+                format: Format::E57,
+                ..
+            }
+        ),
+        "{e}"
+    );
     // E57 with a flipped data byte fails its page checksum.
     let mut e57 = bytes("bun000-grid.e57");
     e57[2000] ^= 0x55;
@@ -249,7 +294,17 @@ fn damaged_headers_give_typed_errors_at_the_place() {
     let ptx = String::from_utf8(bytes("bun000-grid.ptx")).expect("text");
     let huge = ptx.replacen("52\n40\n", "52000000\n40000000\n", 1);
     let e = read_bytes(huge.as_bytes(), None).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { format: Format::Ptx, at: Location::Line(1), .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ReadError::Truncated {
+                format: Format::Ptx,
+                at: Location::Line(1),
+                ..
+            }
+        ),
+        "{e}"
+    );
     // PCD: more points than the binary body holds.
     let pcd = bytes("bunny-binary.pcd");
     let text = String::from_utf8_lossy(&pcd);
@@ -257,13 +312,32 @@ fn damaged_headers_give_typed_errors_at_the_place() {
     let mut bad = pcd.clone();
     bad.splice(at..at + 10, b"POINTS 999".iter().copied());
     let e = read_bytes(&bad, None).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { format: Format::Pcd, .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ReadError::Truncated {
+                format: Format::Pcd,
+                ..
+            }
+        ),
+        "{e}"
+    );
     assert!(e.to_string().contains("declares 999 points"), "{e}");
     // GLB: the header length beyond the file.
     let mut glb = bytes("suzanne-scene.glb");
     glb[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
     let e = read_bytes(&glb, None).unwrap_err();
-    assert!(matches!(e, ReadError::Truncated { format: Format::Glb, at: Location::Byte(8), .. }), "{e}");
+    assert!(
+        matches!(
+            e,
+            ReadError::Truncated {
+                format: Format::Glb,
+                at: Location::Byte(8),
+                ..
+            }
+        ),
+        "{e}"
+    );
 }
 
 #[test]
@@ -283,7 +357,10 @@ fn truncated_files_fail_and_never_panic() {
         "suzanne-embedded.gltf",
     ] {
         let b = bytes(name);
-        let full = read_bytes(&b, Some(name)).expect("whole file").mesh.num_vertices();
+        let full = read_bytes(&b, Some(name))
+            .expect("whole file")
+            .mesh
+            .num_vertices();
         for k in 1..40 {
             let cut = b.len() * k / 40;
             if let Ok(f) = read_bytes(&b[..cut], Some(name)) {

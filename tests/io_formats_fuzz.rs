@@ -10,7 +10,9 @@ use proptest::prelude::*;
 use std::path::PathBuf;
 
 fn file(name: &str) -> Vec<u8> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/formats").join(name);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/formats")
+        .join(name);
     std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
@@ -74,7 +76,10 @@ fn check_consistent(f: &LoadedFile) {
     let n = f.mesh.num_vertices();
     assert!(n > 0);
     assert!(f.mesh.positions().iter().all(|p| p.is_finite()));
-    assert!(f.mesh.faces().all(|face| face.iter().all(|&i| (i as usize) < n)));
+    assert!(f
+        .mesh
+        .faces()
+        .all(|face| face.iter().all(|&i| (i as usize) < n)));
     if let Some(g) = &f.range_grid {
         assert!(g.triangles().iter().flatten().all(|&i| (i as usize) < n));
     }

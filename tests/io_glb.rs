@@ -6,9 +6,7 @@
 //! on any error.
 
 use geofit::geom::{Point3, Vec3};
-use geofit::io::{
-    diverging_colour, read_bytes, to_glb_bytes, Format, GlbOptions, WriteError,
-};
+use geofit::io::{diverging_colour, read_bytes, to_glb_bytes, Format, GlbOptions, WriteError};
 use geofit::mesh::PolyMesh;
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -52,7 +50,11 @@ fn bumpy_grid(n: u32) -> PolyMesh {
     for j in 0..=n {
         for i in 0..=n {
             let (x, y) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
-            p.push(Point3::new(x * 40.0, y * 30.0, 3.0 * (6.0 * x).sin() * (4.0 * y).cos()));
+            p.push(Point3::new(
+                x * 40.0,
+                y * 30.0,
+                3.0 * (6.0 * x).sin() * (4.0 * y).cos(),
+            ));
         }
     }
     let faces = (0..n).flat_map(|j| {
@@ -85,10 +87,20 @@ fn positions_triangles_normals_and_bounds() {
         let column = values.iter().skip(k).step_by(3);
         let min = column.clone().fold(f32::INFINITY, |m, &v| m.min(v));
         let max = column.fold(f32::NEG_INFINITY, |m, &v| m.max(v));
-        assert_eq!(doc["accessors"][pos]["min"][k].as_f64(), Some(f64::from(min)));
-        assert_eq!(doc["accessors"][pos]["max"][k].as_f64(), Some(f64::from(max)));
+        assert_eq!(
+            doc["accessors"][pos]["min"][k].as_f64(),
+            Some(f64::from(min))
+        );
+        assert_eq!(
+            doc["accessors"][pos]["max"][k].as_f64(),
+            Some(f64::from(max))
+        );
     }
-    let normals = floats(&glb, &doc, prim["attributes"]["NORMAL"].as_u64().expect("NORMAL") as usize);
+    let normals = floats(
+        &glb,
+        &doc,
+        prim["attributes"]["NORMAL"].as_u64().expect("NORMAL") as usize,
+    );
     for n in normals.chunks_exact(3) {
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         assert!((len - 1.0).abs() < 1e-6, "{len}");
@@ -119,12 +131,20 @@ fn deviation_colours_extras_and_units() {
     assert_eq!(doc["scenes"][0]["extras"], extras);
     assert_eq!(doc["nodes"][0]["scale"], json!([0.001, 0.001, 0.001]));
     let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
-    let dev = floats(&glb, &doc, attrs["_DEVIATION"].as_u64().expect("_DEVIATION") as usize);
+    let dev = floats(
+        &glb,
+        &doc,
+        attrs["_DEVIATION"].as_u64().expect("_DEVIATION") as usize,
+    );
     assert_eq!(dev.len(), deviation.len());
     for (a, b) in dev.iter().zip(&deviation) {
         assert_eq!(*a, *b as f32);
     }
-    let colours = floats(&glb, &doc, attrs["COLOR_0"].as_u64().expect("COLOR_0") as usize);
+    let colours = floats(
+        &glb,
+        &doc,
+        attrs["COLOR_0"].as_u64().expect("COLOR_0") as usize,
+    );
     for (c, &d) in colours.chunks_exact(3).zip(&deviation) {
         assert!(c.iter().all(|v| (0.0..=1.0).contains(v)));
         let srgb = diverging_colour(d, tol);
@@ -159,17 +179,32 @@ fn custom_colour_map_given_normals_and_points_only() {
     save("custom-map.glb", &glb);
     let doc = json_of(&glb);
     let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
-    let colours = floats(&glb, &doc, attrs["COLOR_0"].as_u64().expect("COLOR_0") as usize);
-    assert!((colours[1] - 0.214).abs() < 1e-3 && colours[2] == 1.0, "{colours:?}");
-    let n = floats(&glb, &doc, attrs["NORMAL"].as_u64().expect("NORMAL") as usize);
+    let colours = floats(
+        &glb,
+        &doc,
+        attrs["COLOR_0"].as_u64().expect("COLOR_0") as usize,
+    );
+    assert!(
+        (colours[1] - 0.214).abs() < 1e-3 && colours[2] == 1.0,
+        "{colours:?}"
+    );
+    let n = floats(
+        &glb,
+        &doc,
+        attrs["NORMAL"].as_u64().expect("NORMAL") as usize,
+    );
     assert_eq!(&n[..3], &[0.0, 0.0, 1.0]);
 
-    let points = PolyMesh::from_points(vec![Point3::ZERO, Point3::new(1.0, 2.0, 3.0)]).expect("points");
+    let points =
+        PolyMesh::from_points(vec![Point3::ZERO, Point3::new(1.0, 2.0, 3.0)]).expect("points");
     let glb = to_glb_bytes(&points, &GlbOptions::default()).expect("glb");
     save("points.glb", &glb);
     let doc = json_of(&glb);
     assert_eq!(doc["meshes"][0]["primitives"][0]["mode"], 0);
-    assert_eq!(read_bytes(&glb, None).expect("reads").mesh.num_vertices(), 2);
+    assert_eq!(
+        read_bytes(&glb, None).expect("reads").mesh.num_vertices(),
+        2
+    );
 }
 
 #[test]
@@ -178,7 +213,10 @@ fn bad_options_are_typed_errors() {
     let short = [0.0; 3];
     let e = to_glb_bytes(&mesh, &GlbOptions::default().with_deviation(&short)).unwrap_err();
     assert!(matches!(e, WriteError::Invalid { .. }), "{e}");
-    assert_eq!(e.to_string(), "cannot write GLB: 3 deviations for 9 vertices");
+    assert_eq!(
+        e.to_string(),
+        "cannot write GLB: 3 deviations for 9 vertices"
+    );
     let e = to_glb_bytes(&mesh, &GlbOptions::default().with_unit_to_metres(-1.0)).unwrap_err();
     assert!(matches!(e, WriteError::Invalid { .. }), "{e}");
     let far = PolyMesh::from_points(vec![Point3::new(1e300, 0.0, 0.0)]).expect("points");
@@ -206,7 +244,11 @@ fn degenerate_triangles_and_lone_vertices_still_give_unit_normals() {
     save("degenerate.glb", &glb);
     let doc = json_of(&glb);
     let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
-    let n = floats(&glb, &doc, attrs["NORMAL"].as_u64().expect("NORMAL") as usize);
+    let n = floats(
+        &glb,
+        &doc,
+        attrs["NORMAL"].as_u64().expect("NORMAL") as usize,
+    );
     assert_eq!(&n[12..15], &[0.0, 0.0, 1.0]);
     for v in n.chunks_exact(3) {
         assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-6);
