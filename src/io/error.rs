@@ -43,6 +43,13 @@ impl fmt::Display for Location {
 /// );
 /// assert_eq!(read_bytes(b"# only a comment\n", Some("a.obj")).unwrap_err().to_string(), "OBJ: the file has no points");
 /// assert!(matches!(read_path("/no/such/file.ply".as_ref()), Err(ReadError::Io(_))));
+/// let gltf = br#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_draco_mesh_compression"]}"#;
+/// assert_eq!(msg(gltf), "glTF extensionsRequired 0: not supported: the mesh data is compressed with KHR_draco_mesh_compression");
+/// let external = br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"a.bin","byteLength":12}],
+///     "bufferViews":[{"buffer":0,"byteLength":12}],
+///     "accessors":[{"bufferView":0,"componentType":5126,"count":1,"type":"VEC3"}],
+///     "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#;
+/// assert!(msg(external).starts_with("glTF buffer 0: the data is in the external file 'a.bin'"));
 /// ```
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]

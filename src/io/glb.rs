@@ -66,6 +66,9 @@ pub fn diverging_colour(deviation: f64, tolerance: f64) -> [f32; 3] {
         return full;
     }
     let t = deviation.abs() / tolerance;
+    if t >= 3.0 {
+        return full;
+    }
     if t <= 1.0 {
         lerp(
             DIVERGING_ZERO,
@@ -73,7 +76,7 @@ pub fn diverging_colour(deviation: f64, tolerance: f64) -> [f32; 3] {
             t as f32,
         )
     } else {
-        let s = ((t - 1.0) / 2.0).min(1.0) as f32;
+        let s = ((t - 1.0) / 2.0) as f32;
         lerp(lerp(full, DIVERGING_ZERO, PALE_OUTSIDE), full, s)
     }
 }
@@ -95,10 +98,11 @@ fn srgb_to_linear(c: f32) -> f32 {
 /// use geofit::{geom::Point3, mesh::PolyMesh};
 /// let mesh = PolyMesh::try_new(vec![Point3::ZERO, Point3::X, Point3::Y], [[0u32, 1, 2]])?;
 /// let deviation = [0.0, 0.02, -0.2];
+/// let figures = serde_json::json!({ "e_max_percent": 0.049 });
 /// let options = GlbOptions::default()
 ///     .with_deviation(&deviation)
 ///     .with_tolerance(0.05)
-///     .with_extras(serde_json::json!({ "e_max_percent": 0.049 }))
+///     .with_extras(&figures)
 ///     .with_unit_to_metres(0.001);
 /// let glb = to_glb_bytes(&mesh, &options)?;
 /// assert_eq!(&glb[..4], b"glTF");

@@ -9,7 +9,7 @@
 //! laser did not measure is written as `0 0 0`: it becomes an empty grid cell and no point, as
 //! in a Cyberware range grid.
 
-use super::text::{coordinate, lines, parse_i64, show, tokens};
+use super::text::{coordinate, parse_i64, show, tokens};
 use super::{Format, LoadedFile, Location, RangeGrid, ReadError};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
@@ -20,47 +20,64 @@ const PTX: Format = Format::Ptx;
 /// declare against the bytes that follow.
 const MIN_POINT_LINE: usize = 6;
 
-/// Non-blank lines with their numbers and the byte offset just past them.
+/// The non-blank lines of a file, with their 1-based numbers, and how many bytes remain.
 struct Lines<'a> {
-    inner: std::iter::Peekable<Box<dyn Iterator<Item = (usize, &'a [u8], usize)> + 'a>>,
-    len: usize,
+    bytes: &'a [u8],
+    /// Byte offset of the next line not yet returned.
+    pos: usize,
+    /// Number of the line starting at `pos`.
+    line: usize,
     /// The number of the last line returned (0 before the first).
     last: usize,
 }
 
 impl<'a> Lines<'a> {
     fn new(bytes: &'a [u8]) -> Lines<'a> {
-        let mut end = 0;
-        let iter = lines(bytes).map(move |(n, line)| {
-            // Past the line and its terminator (the last line may have none).
-            end += line.len() + 1;
-            (n, line, end)
-        });
-        let iter: Box<dyn Iterator<Item = (usize, &'a [u8], usize)> + 'a> =
-            Box::new(iter.filter(|(_, l, _)| !l.trim_ascii().is_empty()));
         Lines {
-            inner: iter.peekable(),
-            len: bytes.len(),
+            bytes,
+            pos: 0,
+            line: 1,
             last: 0,
         }
     }
 
-    fn next(&mut self) -> Option<(usize, &'a [u8])> {
-        let (n, l, _) = self.inner.next()?;
-        self.last = n;
-        Some((n, l))
+    /// Skips blank lines; true when a non-blank line starts at `pos`.
+    fn skip_blank(&mut self) -> bool {
+        while self.pos < self.bytes.len() {
+            let rest = &self.bytes[self.pos..];
+            let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+            if !rest[..len].trim_ascii().is_empty() {
+                return true;
+            }
+            self.pos += len + 1;
+            self.line += 1;
+        }
+        false
     }
 
-    /// Bytes after the current position (0 at the end).
-    fn remaining(&mut self) -> usize {
-        match self.inner.peek() {
-            Some(&(_, line, end)) => self.len.saturating_sub(end.saturating_sub(line.len() + 1)),
-            None => 0,
+    fn next(&mut self) -> Option<(usize, &'a [u8])> {
+        if !self.skip_blank() {
+            return None;
         }
+        let rest = &self.bytes[self.pos..];
+        let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+        let line = &rest[..len];
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let n = self.line;
+        self.pos += len + 1;
+        self.line += 1;
+        self.last = n;
+        Some((n, line))
+    }
+
+    /// Bytes from the next non-blank line to the end (0 at the end).
+    fn remaining(&mut self) -> usize {
+        self.skip_blank();
+        self.bytes.len().saturating_sub(self.pos)
     }
 
     fn at_end(&mut self) -> bool {
-        self.inner.peek().is_none()
+        !self.skip_blank()
     }
 }
 
