@@ -27,11 +27,6 @@ const MAX_CELLS_PER_POINT: usize = 16;
 /// can pack a constant field into zero bits).
 const MAX_POINTS_PER_BYTE: usize = 8;
 
-/// Whether the file starts with the E57 signature.
-pub fn looks_like(bytes: &[u8]) -> bool {
-    bytes.starts_with(b"ASTM-E57")
-}
-
 fn invalid(at: Location, e: impl std::fmt::Display) -> ReadError {
     ReadError::Syntax {
         format: E57,

@@ -16,10 +16,11 @@
 //!
 //! The scanner formats use a crate where the format is hard and the crate is careful, and are
 //! hand-written where the format is simple or the crate breaks these rules:
-//! - **E57**: the `e57` crate (pure Rust, no unsafe, no panics by its lints; CRC-checked pages,
+//! - **E57**: the `e57` crate (cargo feature `e57`, on by default) (pure Rust, no unsafe, no panics by its lints; CRC-checked pages,
 //!   bit-packed records and the XML tree are real work). Its header fields are checked against
 //!   the file size first.
-//! - **LAZ**: the `laz` crate (the only LASzip decoder in Rust), used sequentially; the chunk
+//! - **LAZ**: the `laz` crate (cargo feature `laz`, on by default; the only LASzip decoder in
+//!   Rust), used sequentially; the chunk
 //!   table and the layer sizes of LAS 1.4 chunks are checked against the bytes before it
 //!   allocates by them. **LAS** itself is a fixed binary layout and is read by hand: the
 //!   `las` crate 0.11 resizes an extended VLR to the 64-bit length the file states (a few
@@ -41,6 +42,7 @@
 //! ```
 
 mod detect;
+#[cfg(feature = "e57")]
 mod e57;
 mod error;
 mod glb;
@@ -189,7 +191,10 @@ pub fn read_bytes(bytes: &[u8], name: Option<&str>) -> Result<LoadedFile, ReadEr
         Format::Obj => obj::read(bytes)?,
         Format::Stl => stl::read(bytes)?,
         Format::Xyz => xyz::read(bytes)?,
+        #[cfg(feature = "e57")]
         Format::E57 => e57::read(bytes)?,
+        #[cfg(not(feature = "e57"))]
+        Format::E57 => return Err(not_built(Format::E57, "e57")),
         Format::Las | Format::Laz => las::read(bytes)?,
         Format::Pcd => pcd::read(bytes)?,
         Format::Ptx => ptx::read(bytes)?,
@@ -201,6 +206,16 @@ pub fn read_bytes(bytes: &[u8], name: Option<&str>) -> Result<LoadedFile, ReadEr
         });
     }
     Ok(loaded)
+}
+
+/// The error for a format whose reader was left out of the build by its cargo feature.
+#[cfg(any(not(feature = "e57"), not(feature = "laz")))]
+fn not_built(format: Format, feature: &str) -> ReadError {
+    ReadError::Unsupported {
+        format,
+        at: Location::Byte(0),
+        message: format!("geofit was built without its '{feature}' feature"),
+    }
 }
 
 /// Reads a file from disk; see [`read_bytes`].
