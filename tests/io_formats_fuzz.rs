@@ -67,8 +67,12 @@ fn samples() -> Vec<(&'static str, Vec<u8>)> {
         "bunny-compressed.pcd",
         "suzanne-scene.glb",
     ] {
+        // laz 0.13 has a `debug_assert!` in its arithmetic decoder that a corrupt stream trips
+        // (decoders.rs, `sym < (1 << 16)`); release builds, the browser's included, truncate
+        // and go on to a typed error, so the LAZ sample is fuzzed in release builds only.
+        let laz_fuzzable = cfg!(feature = "laz") && !cfg!(debug_assertions);
         if (name.ends_with(".e57") && !cfg!(feature = "e57"))
-            || (name.ends_with(".laz") && !cfg!(feature = "laz"))
+            || (name.ends_with(".laz") && !laz_fuzzable)
         {
             continue;
         }
