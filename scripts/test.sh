@@ -50,12 +50,17 @@ run_interop() {
     done
 }
 
+# tests/io_glb.rs writes its GLBs here; the Khronos validator checks them after the native tests.
+GEOFIT_GLB_DIR="$(realpath -m "${CARGO_TARGET_DIR:-target}")/glb-samples"
+export GEOFIT_GLB_DIR
+
 total_start=$(date +%s)
 step "install" bash scripts/install.sh --browser
 step "cargo fmt --check" cargo fmt --check
 step "clippy native" cargo clippy --all-targets -- -D warnings
 step "clippy wasm32" cargo clippy --target wasm32-unknown-unknown --lib -- -D warnings
 step "cargo test --release" cargo test --release
+step "glTF validator" node scripts/validate-glb.mjs "$GEOFIT_GLB_DIR"
 step "wasm build" bash scripts/build-wasm.sh
 step "typecheck www" node_modules/.bin/tsc -p tsconfig.json
 step "browser tests" run_e2e

@@ -47,8 +47,8 @@ pub use error::ReconstructError;
 
 use crate::geom::{Point3, Vec3};
 use crate::io::RangeGrid;
-use crate::mesh::{simplify_with, SimplifyOptions};
 use crate::mesh::PolyMesh;
+use crate::mesh::{simplify_with, SimplifyOptions};
 use neighbours::{median, Neighbours};
 
 /// Which kind of surface the points sample.

@@ -10,6 +10,10 @@ pub enum Location {
     Line(usize),
     /// 0-based byte offset from the start of the file.
     Byte(usize),
+    /// A numbered part of a structured file: `("accessor", 3)` in glTF, `("scan", 1)` in E57
+    /// or PTX. Used where a byte offset would not help the user find the problem (JSON
+    /// objects, a library-decoded section) but the part's index does.
+    Item(&'static str, usize),
 }
 
 impl fmt::Display for Location {
@@ -17,6 +21,7 @@ impl fmt::Display for Location {
         match self {
             Location::Line(n) => write!(f, "line {n}"),
             Location::Byte(n) => write!(f, "byte {n}"),
+            Location::Item(kind, n) => write!(f, "{kind} {n}"),
         }
     }
 }
@@ -38,6 +43,13 @@ impl fmt::Display for Location {
 /// );
 /// assert_eq!(read_bytes(b"# only a comment\n", Some("a.obj")).unwrap_err().to_string(), "OBJ: the file has no points");
 /// assert!(matches!(read_path("/no/such/file.ply".as_ref()), Err(ReadError::Io(_))));
+/// let gltf = br#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_draco_mesh_compression"]}"#;
+/// assert_eq!(msg(gltf), "glTF extensionsRequired 0: not supported: the mesh data is compressed with KHR_draco_mesh_compression");
+/// let external = br#"{"asset":{"version":"2.0"},"buffers":[{"uri":"a.bin","byteLength":12}],
+///     "bufferViews":[{"buffer":0,"byteLength":12}],
+///     "accessors":[{"bufferView":0,"componentType":5126,"count":1,"type":"VEC3"}],
+///     "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}]}"#;
+/// assert!(msg(external).starts_with("glTF buffer 0: the data is in the external file 'a.bin'"));
 /// ```
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]
@@ -46,7 +58,10 @@ pub enum ReadError {
     #[error("the file is empty")]
     Empty,
     /// The content matches no supported format.
-    #[error("unknown file format: expected PLY, OBJ, STL or XYZ/CSV/PTS point text")]
+    #[error(
+        "unknown file format: expected PLY, OBJ, STL, XYZ/CSV/PTS point text, E57, LAS/LAZ, PCD, \
+         PTX or glTF/GLB"
+    )]
     UnknownFormat,
     /// The operating system refused to read the file.
     #[error("cannot read the file: {0}")]
@@ -96,6 +111,28 @@ pub enum ReadError {
     NoPoints {
         /// The format being parsed.
         format: Format,
+    },
+    /// The file uses a feature of its format that geofit does not decode (a glTF compression
+    /// extension, an E57 scan with only spherical coordinates in a mode not supported, …).
+    #[error("{format} {at}: not supported: {message}")]
+    Unsupported {
+        /// The format being parsed.
+        format: Format,
+        /// Where the feature is used.
+        at: Location,
+        /// What is not supported.
+        message: String,
+    },
+    /// The file's data lives in another file (a glTF buffer with a relative `uri`), which
+    /// cannot be opened from the bytes of this one. Re-export as GLB or with embedded buffers.
+    #[error("{format} {at}: the data is in the external file '{uri}'; open a .glb or a .gltf with embedded (data:) buffers instead")]
+    ExternalData {
+        /// The format being parsed.
+        format: Format,
+        /// The buffer that refers to the file.
+        at: Location,
+        /// The file name or URI as written.
+        uri: String,
     },
     /// The parsed data does not form a valid mesh.
     #[error("invalid mesh: {0}")]

@@ -1,5 +1,5 @@
 //! Writers: OBJ (text, exact decimal round trip), binary little-endian PLY (f64 coordinates)
-//! and binary STL (f32, triangulated, as the format requires).
+//! and binary STL (f32, triangulated, as the format requires); GLB is in `glb.rs`.
 
 use crate::mesh::PolyMesh;
 use std::io::{BufWriter, Write};
@@ -11,6 +11,9 @@ use thiserror::Error;
 /// use geofit::{io::to_obj_bytes, mesh::PolyMesh, geom::Point3};
 /// let mesh = PolyMesh::from_points(vec![Point3::ZERO])?;
 /// assert_eq!(to_obj_bytes(&mesh)?, b"# written by geofit\nv 0 0 0\n");
+/// let options = geofit::io::GlbOptions::default().with_deviation(&[f64::NAN]);
+/// let err = geofit::io::to_glb_bytes(&mesh, &options).unwrap_err();
+/// assert_eq!(err.to_string(), "cannot write GLB: the deviation of vertex 0 is not finite");
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 #[derive(Debug, Error)]
@@ -25,6 +28,15 @@ pub enum WriteError {
         /// The format.
         format: &'static str,
         /// What overflowed.
+        what: String,
+    },
+    /// The data given with the mesh does not fit it (GLB: a deviation or normal list of the
+    /// wrong length, a non-finite deviation, a non-positive unit scale).
+    #[error("cannot write {format}: {what}")]
+    Invalid {
+        /// The format.
+        format: &'static str,
+        /// What is wrong.
         what: String,
     },
 }

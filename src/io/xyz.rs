@@ -1,7 +1,8 @@
 //! Plain point text: XYZ, CSV and PTS. One point per line, fields separated by whitespace,
 //! commas or semicolons; leading non-numeric lines are a header; `#` and `//` lines are
 //! comments; a line holding one integer is a PTS point count and is skipped; columns beyond
-//! x, y, z (intensity, colour, normals) are ignored. Files with two numeric columns are 2D
+//! x, y, z (intensity, colour, normals) are ignored; a PTS count must match the number of point
+//! lines that follow it (up to the next count line or the end). Files with two numeric columns are 2D
 //! points (z = 0). In a line separated by semicolons a comma is a decimal comma (`1,5;2,5`),
 //! as spreadsheets in many locales write CSV.
 
@@ -50,16 +51,52 @@ fn is_comment(line: &[u8]) -> bool {
     t.starts_with(b"#") || t.starts_with(b"//")
 }
 
-fn is_count_line(line: &[u8]) -> bool {
+/// The count of a PTS count line (a line holding one integer), if `line` is one.
+fn count_line(line: &[u8]) -> Option<i64> {
     let mut f = fields(line);
-    matches!((f.next(), f.next()), (Some(n), None) if parse_i64(n).is_some())
+    match (f.next(), f.next()) {
+        (Some(n), None) => parse_i64(n),
+        _ => None,
+    }
+}
+
+/// A PTS block's count (its line and value) against the points read since.
+fn check_count(declared: Option<(usize, i64)>, read: usize) -> Result<(), ReadError> {
+    let Some((line, n)) = declared else {
+        return Ok(());
+    };
+    if i64::try_from(read).ok() == Some(n) {
+        return Ok(());
+    }
+    let message = format!("the PTS count line says {n} points, {read} follow it");
+    Err(if i64::try_from(read).is_ok_and(|r| r < n) {
+        ReadError::Truncated {
+            format: XYZ,
+            at: Location::Line(line),
+            message,
+        }
+    } else {
+        ReadError::Syntax {
+            format: XYZ,
+            at: Location::Line(line),
+            message,
+        }
+    })
 }
 
 pub fn read(bytes: &[u8]) -> Result<LoadedFile, ReadError> {
     let mut positions = Vec::new();
     let mut columns = 0;
+    let mut declared = None;
+    let mut since = 0;
     for (line_no, line) in lines(bytes) {
-        if is_comment(line) || is_count_line(line) || fields(line).next().is_none() {
+        if let Some(n) = count_line(line) {
+            check_count(declared, since)?;
+            declared = Some((line_no, n));
+            since = 0;
+            continue;
+        }
+        if is_comment(line) || fields(line).next().is_none() {
             continue;
         }
         if columns == 0 {
@@ -70,7 +107,9 @@ pub fn read(bytes: &[u8]) -> Result<LoadedFile, ReadError> {
             }
         }
         positions.push(point(line, line_no, columns)?);
+        since += 1;
     }
+    check_count(declared, since)?;
     let mesh = PolyMesh::from_points(positions)?;
     Ok(LoadedFile {
         dimension: if columns == 2 { 2 } else { 3 },
@@ -134,6 +173,25 @@ mod tests {
     fn pts_count_lines_and_2d_files() {
         let f = read(b"2\n1 2 3 10 255 0 0\n4 5 6 10 0 255 0\n").unwrap();
         assert_eq!(f.mesh.num_vertices(), 2);
+        // Blocks, each with its count (Cyclone writes one per scan).
+        let f = read(b"1\n1 2 3 -5\n2\n1 2 3 -5\n4 5 6 7\n").unwrap();
+        assert_eq!(f.mesh.num_vertices(), 3);
+        let e = read(b"3\n1 2 3 10\n4 5 6 10\n").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "XYZ line 1: file ends early: the PTS count line says 3 points, 2 follow it"
+        );
+        let e = read(b"1\n1 2 3 10\n4 5 6 10\n").unwrap_err();
+        assert!(
+            matches!(
+                e,
+                ReadError::Syntax {
+                    at: Location::Line(1),
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let f = read(b"0.5 1\n2 3\n").unwrap();
         assert_eq!(f.dimension, 2);
         assert_eq!(f.mesh.positions()[1], Point3::new(2.0, 3.0, 0.0));

@@ -379,7 +379,14 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
         caught(() => curve.exportObj()),
         caught(() => loop.exportIges()),
         caught(() => new m.Fitter(mesh, { scheme: 'bspline-surface', initial: 4, maxIter: 1 }).step()),
-        caught(() => new m.Fitter(mesh, { initial: 100 })),
+        // Below the 244 vertices where QEM used to stop: it now goes on with relaxed rules.
+        caught(() => {
+          const f = new m.Fitter(mesh, { initial: 100, maxIter: 1 });
+          const n = f.step().controlPoints;
+          f.free();
+          return `started with ${n}`;
+        }),
+        caught(() => new m.Fitter(mesh, { initial: 0 })),
       ];
       // Bare points are meshed first (here by Delaunay, an open scan), then fitted like a mesh.
       const cloudFitter = new m.Fitter(cloud, { scheme: 'loop', maxIter: 2 });
@@ -406,7 +413,9 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     assert.match(messages[5], /a curve has no surface to export as a mesh/);
     assert.match(messages[6], /IGES and STEP export a B-spline/);
     assert.doesNotMatch(messages[7], /not an Error/);
-    assert.match(messages[8], /simplification: cannot go below \d+ vertices \(target 100\)/);
+    const started = Number(/^started with (\d+)$/.exec(messages[8])?.[1]);
+    assert.ok(started >= 100 && started <= 400, messages[8]);
+    assert.match(messages[9], /initial/);
   });
 
   test('keyboard: arrow keys turn the focused view; every control has a label', async () => {

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 /// Arguments of `geofit info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS).
+    /// Point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS, E57, LAS/LAZ, PCD, PTX, glTF/GLB).
     file: PathBuf,
     /// Print one JSON object on one line instead of indented JSON.
     #[arg(long)]
@@ -15,7 +15,9 @@ pub struct Args {
 
 /// Reads the file and prints its format, counts and bounding box. `triangles` counts the mesh
 /// after triangulating polygons and strips; a range scan's grid is reported as
-/// `range_grid: [cols, rows]` and not counted as triangles.
+/// `range_grid: [cols, rows]` and not counted as triangles. The scanner formats with scans
+/// (E57, LAS/LAZ, PTX) add `scans` and `grid_kept` (a file of several scans keeps no grid);
+/// formats that define their unit (E57, glTF/GLB: metres) add `unit_to_metres`.
 pub fn run(args: Args) -> Result<(), String> {
     let loaded = read_input(&args.file)?;
     let mesh = &loaded.mesh;
@@ -29,6 +31,13 @@ pub fn run(args: Args) -> Result<(), String> {
     });
     if let Some(grid) = &loaded.range_grid {
         report["range_grid"] = serde_json::json!([grid.cols(), grid.rows()]);
+    }
+    if let Some(scans) = loaded.scans {
+        report["scans"] = scans.into();
+        report["grid_kept"] = loaded.range_grid.is_some().into();
+    }
+    if let Some(unit) = loaded.unit_to_metres {
+        report["unit_to_metres"] = unit.into();
     }
     if !loaded.polylines.is_empty() {
         report["polylines"] = loaded.polylines.len().into();

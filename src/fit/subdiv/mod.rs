@@ -24,6 +24,9 @@ use index::SurfaceIndex;
 use std::collections::HashSet;
 use web_time::Instant;
 
+/// Below this share of the option's weight the fairness is switched off altogether.
+const FAIRNESS_FLOOR: f64 = 1e-6;
+
 /// A data point's foot point on the limit surface.
 type FootPoint = Nearest<SurfaceParam>;
 
@@ -79,6 +82,8 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// `options.newton` with its step tolerance in model units.
     newton: NewtonOptions,
     since_refine: usize,
+    /// The fairness weight of the next move (see [`SubdivFitter::adapt_fairness`]).
+    fairness: f64,
     accel: Accelerator,
     index: SurfaceIndex,
     scratch: Vec<(u32, f64)>,
@@ -125,6 +130,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .with_step_tol(options.newton.step_tol * diagonal),
             options,
             since_refine: 0,
+            fairness: 0.0,
             accel: Accelerator::new(options.acceleration),
             index,
             scratch: Vec::new(),
@@ -280,11 +286,11 @@ impl<S: ControlSurface> SubdivFitter<S> {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
                 let normals: Vec<Vec3> = self.feet.iter().map(|f| f.direction).collect();
-                let fairness = (self.options.fairness > 0.0)
-                    .then(|| Fairness::of(&self.surface.control_polygons()));
+                let fairness =
+                    (self.fairness > 0.0).then(|| Fairness::of(&self.surface.control_polygons()));
                 let fair = fairness
                     .as_ref()
-                    .map(|f| (f, old_points.as_slice(), self.options.fairness));
+                    .map(|f| (f, old_points.as_slice(), self.fairness));
                 stencils.cg(
                     &self.error_vectors(),
                     &normals,
@@ -501,6 +507,25 @@ impl<S: ControlSurface> SubdivFitter<S> {
         self
     }
 
+    /// Fairness holds the control points few data points pull on, but it also pulls the
+    /// surface off the data it could reach (a fit of the fitter's own limit surface would never
+    /// end exactly). So it is a means to the surface → data bound, not a prior: while E_back is
+    /// within the E_max tolerance (or is not measured) the weight halves every iteration, and
+    /// once E_back exceeds it the weight is back to the option's.
+    fn adapt_fairness(&mut self) {
+        let strays = match (self.state.back(), self.state.tolerances().max_pct) {
+            (Some(b), Some(tol)) => b.max_pct > tol,
+            _ => false,
+        };
+        self.fairness = if strays {
+            self.options.fairness
+        } else if self.fairness > self.options.fairness * FAIRNESS_FLOOR {
+            self.fairness * 0.5
+        } else {
+            0.0
+        };
+    }
+
     fn due_for_refinement(&self, improvement: f64) -> bool {
         self.options.refine
             && self.num_control_points() < self.budget()
@@ -521,6 +546,7 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         let before = self.state.stats().e_rms;
         let moved = self.move_control_points();
         self.measure_back();
+        self.adapt_fairness();
         self.since_refine += 1;
         let improvement = if before > 0.0 && moved {
             (before - self.state.stats().e_rms) / before
