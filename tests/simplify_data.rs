@@ -6,31 +6,11 @@
 mod common;
 
 use common::manifold::{assert_manifold, boundary_loops, euler_characteristic};
+use common::shared_meshes;
 use geofit::cloud::{reconstruct, ReconstructOptions};
 use geofit::mesh::{deviation, foldovers};
 use geofit::mesh::{repair, simplify_with_report, ControlMesh, PolyMesh, SimplifyOptions};
-use std::path::{Path, PathBuf};
-
-/// The meshes of the shared data and corpus, or `None` (with a message) where they are absent.
-fn shared_meshes() -> Option<Vec<PathBuf>> {
-    let data = common::data_dir();
-    if !data.is_dir() {
-        eprintln!("skipped: no shared data at {}", data.display());
-        return None;
-    }
-    let mut files = Vec::new();
-    for dir in [data.clone(), data.join("corpus")] {
-        for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
-            let p = e.path();
-            let ext = p.extension().and_then(|x| x.to_str()).unwrap_or("");
-            if ["obj", "ply", "stl"].contains(&ext) {
-                files.push(p);
-            }
-        }
-    }
-    files.sort();
-    Some(files)
-}
+use std::path::Path;
 
 /// The file's mesh; a bare point file is meshed first.
 fn surface(path: &Path) -> PolyMesh {

@@ -10,7 +10,7 @@
 //   building  the worker was asked to build a fit; its first frame moves on to paused/running
 //   paused    a fit exists and does not iterate
 //   running   the worker iterates slice by slice
-//   converged, max_iterations   the fit stopped (Reset rebuilds it)
+//   converged, max_iterations, stalled   the fit stopped (Reset rebuilds it)
 //   error     the fit could not be built
 import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
@@ -32,6 +32,7 @@ const DOWNLOADS = {
 const STATUS_TEXT = {
   building: 'building the control net…', paused: 'paused', running: 'fitting…',
   converged: 'converged: tolerances met', max_iterations: 'stopped: iteration cap reached',
+  stalled: 'stalled: the errors stopped falling and the control budget is spent',
   error: 'error', idle: 'press Play or Step to fit',
 };
 
@@ -85,7 +86,8 @@ class FitPanel {
       iso: /** @type {HTMLInputElement} */ (el('show-iso')), initialMesh: /** @type {HTMLInputElement} */ (el('show-initial')),
       chart: /** @type {HTMLCanvasElement} */ (el('fit-chart')),
       status: el('fit-status'), iter: el('fit-iter'), ctrl: el('fit-ctrl'), eAvg: el('fit-eavg'),
-      eMax: el('fit-emax'), eRms: el('fit-erms'), ms: el('fit-ms'), total: el('fit-total'),
+      eMax: el('fit-emax'), eRms: el('fit-erms'), eBack: el('fit-eback'), ms: el('fit-ms'), total: el('fit-total'),
+      intake: el('fit-intake'),
       legendTol: el('legend-tol'), legendNeg: el('legend-neg'),
     };
     this.form = new FitForm(this.ui.form);
@@ -146,7 +148,8 @@ class FitPanel {
     this.worker.postMessage({ type: MSG.clear, generation: this.generation });
     Object.assign(this.figures, { lastStats: null, history: [] });
     const u = this.ui;
-    for (const dd of [u.iter, u.ctrl, u.eAvg, u.eMax, u.eRms, u.ms, u.total]) dd.textContent = '—';
+    for (const dd of [u.iter, u.ctrl, u.eAvg, u.eMax, u.eRms, u.eBack, u.ms, u.total]) dd.textContent = '—';
+    this.showIntake([]);
     delete document.body.dataset.fitIter;
     const g = /** @type {CanvasRenderingContext2D | null} */ (u.chart.getContext('2d', CHART_CONTEXT));
     g?.clearRect(0, 0, u.chart.width, u.chart.height);
@@ -221,12 +224,24 @@ class FitPanel {
     u.eAvg.textContent = `${fmtPct(s.eAvgPct)} (${fmtUnits(s.eAvg)} units)`;
     u.eMax.textContent = `${fmtPct(s.eMaxPct)} (${fmtUnits(s.eMax)} units)`;
     u.eRms.textContent = `${fmtPct(s.eRmsPct)} (${fmtUnits(s.eRms)} units)`;
+    u.eBack.textContent = s.eBackMaxPct == null ? 'not measured' : `${fmtPct(s.eBackMaxPct)} (p99 ${fmtPct(s.eBackP99Pct)})`;
     u.ms.textContent = `${s.ms.toFixed(1)} ms`;
     u.total.textContent = `${(s.totalMs / 1000).toFixed(2)} s`;
     const tol = this.tolMaxUnits(s);
     u.legendTol.textContent = `+${fmtUnits(tol)}`;
     u.legendNeg.textContent = `−${fmtUnits(tol)}`;
     document.body.dataset.fitIter = String(s.iter);
+  }
+
+  /**
+   * Lists what the core did to the data before fitting (repair, reconstruction, a
+   * simplification that stopped above its target); hidden when nothing was done.
+   * @param {string[]} notes
+   */
+  showIntake(notes) {
+    const list = this.ui.intake;
+    list.replaceChildren(...notes.map((n) => Object.assign(document.createElement('li'), { textContent: n })));
+    list.hidden = notes.length === 0;
   }
 
   /** The tolerances in force, for the chart's dashed lines. */
@@ -239,7 +254,10 @@ class FitPanel {
   // animation frame. Frames that arrive meanwhile are skipped but the newest one.
   stage(k, viewer, m) {
     if (k === 0) {
-      if (m.once) this.once = m.once;
+      if (m.once) {
+        this.once = m.once;
+        this.showIntake(m.once.notes);
+      }
       this.frame = m;
       Object.assign(this.figures, { lastStats: m.stats, history: m.history });
       this.figures.frames += 1;

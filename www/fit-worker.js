@@ -61,7 +61,11 @@ function postFrame(f, kind) {
   control.free();
   if (kind === 'start') {
     const initial = f.initialMesh();
-    frame.once = { data: f.dataPositions(), initial: { positions: initial.positions, edges: initial.edges } };
+    frame.once = {
+      data: f.dataPositions(),
+      initial: { positions: initial.positions, edges: initial.edges },
+      notes: f.intakeNotes(),
+    };
     initial.free();
   }
   post(frame, frameTransfers(frame));

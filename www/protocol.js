@@ -27,10 +27,10 @@
  *   stats: Object<string, any>, history: Object<string, any>[], errors: Float32Array,
  *   limit: Shape, control: { positions: Float32Array, edges: Uint32Array },
  *   vectors: Float32Array, iso: Float32Array,
- *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array } },
+ *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array }, notes: string[] },
  * }} FrameMessage
- *   The state of the fit after a slice; `once` (data points and initial control net) only on
- *   the first frame of a fit.
+ *   The state of the fit after a slice; `once` (data points, initial control net and what was
+ *   done to the data on intake) only on the first frame of a fit.
  * @typedef {{ type: 'exported', what: string, bytes: Uint8Array }} ExportedMessage
  * @typedef {{ type: 'error', during: string, generation: number, message: string }} ErrorMessage
  * @typedef {FrameMessage | ExportedMessage | ErrorMessage} FromWorker

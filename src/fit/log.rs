@@ -3,6 +3,7 @@
 
 use super::reference::BackStats;
 use super::{ErrorStats, FitStatus, IterationRecord, ReconstructionReport};
+use crate::mesh::SimplifyReport;
 use web_time::Instant;
 
 /// History and status of a fit, kept the same way by every engine.
@@ -14,6 +15,7 @@ pub struct FitLog {
     precompute_s: f64,
     fit_s: f64,
     reconstruction: Option<ReconstructionReport>,
+    simplification: Option<SimplifyReport>,
 }
 
 impl FitLog {
@@ -26,6 +28,7 @@ impl FitLog {
             precompute_s: start.elapsed().as_secs_f64(),
             fit_s: 0.0,
             reconstruction: None,
+            simplification: None,
         }
     }
 
@@ -107,5 +110,49 @@ impl FitLog {
     /// Records how bare points were meshed before the fit.
     pub fn set_reconstruction(&mut self, report: Option<ReconstructionReport>) {
         self.reconstruction = report;
+    }
+
+    /// How the initial control mesh was made by QEM (and what repairing the data mesh on the
+    /// way changed), when it was.
+    pub fn simplification(&self) -> Option<&SimplifyReport> {
+        self.simplification.as_ref()
+    }
+
+    /// Records how the initial control mesh was made.
+    pub fn set_simplification(&mut self, report: Option<SimplifyReport>) {
+        self.simplification = report;
+    }
+
+    /// What happened to the data before the first iteration, one line each for people (the
+    /// CLI prints them, the page shows them): the reconstruction of bare points, the repair of
+    /// the mesh, and a simplification that relaxed its guards or stopped above its target.
+    pub fn intake_notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if let Some(r) = &self.reconstruction {
+            notes.push(format!(
+                "reconstructed {} surface ({}): {} triangles, {} outliers removed",
+                r.kind, r.method, r.triangles, r.outliers
+            ));
+        }
+        if let Some(s) = &self.simplification {
+            if s.repair.changed() {
+                notes.push(s.repair.summary.clone());
+            }
+            let loose = s.repair.unreferenced_vertices.count;
+            if loose > 0 {
+                notes.push(format!("{loose} vertices in no face kept as data points"));
+            }
+            if !s.relaxations.is_empty() {
+                notes.push(format!(
+                    "simplified to {} vertices, relaxing its shape guards {} times",
+                    s.vertices,
+                    s.relaxations.len()
+                ));
+            }
+            if let Some(floor) = &s.floor_note {
+                notes.push(floor.clone());
+            }
+        }
+        notes
     }
 }

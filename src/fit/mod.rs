@@ -12,6 +12,7 @@
 //! | `curve` | [`CurveFitter`], [`KnotPlacementFitter`]: B-spline curves (SPEC §1.9, §3) |
 //! | `state`, `log` | [`FitState`], [`FitLog`]: data, errors, history and status, kept alike by every engine |
 //! | `report` | [`FitReport`]: the machine-readable summary of any fit |
+//! | `stall` | when a fit that can no longer refine gives up ([`FitStatus::Stalled`]) |
 
 mod accel;
 mod curve;
@@ -21,6 +22,7 @@ mod parallel;
 mod reference;
 mod report;
 mod spec;
+mod stall;
 mod state;
 mod stats;
 mod subdiv;
@@ -62,6 +64,10 @@ pub enum FitStatus {
     Converged,
     /// The iteration cap was reached first (or nothing could be refined any more).
     MaxIterations,
+    /// The tolerances are out of reach: no refinement is left (the control budget is spent,
+    /// or refinement is off) and the errors stopped falling, or fall too slowly to meet the
+    /// tolerances within the iteration cap (the rule is in `src/fit/stall.rs`).
+    Stalled,
 }
 
 /// A drawable shape of a fit: its control net or its fitted surface or curve.

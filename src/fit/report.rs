@@ -2,6 +2,7 @@
 //! builder, [`FitReport::of`], for every engine.
 
 use super::{FitStatus, Fitter, IterationRecord, ReconstructionReport};
+use crate::mesh::SimplifyReport;
 use serde::Serialize;
 
 /// The set-up, the final errors, the times and one entry per iteration of a fit.
@@ -35,6 +36,13 @@ pub struct FitReport {
     /// What was reconstructed from bare points before simplification (absent for meshes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reconstruction: Option<ReconstructionReport>,
+    /// How the initial control mesh was made by QEM, with what repairing the data mesh
+    /// changed (`simplification.repair`); absent when a control mesh was given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simplification: Option<SimplifyReport>,
+    /// What happened to the data before the first iteration, for people
+    /// ([`FitLog::intake_notes`](super::FitLog::intake_notes)).
+    pub intake: Vec<String>,
     /// Seconds before the first iteration (reading, meshing, simplification, the engine's
     /// set-up and first foot points).
     pub precompute_s: f64,
@@ -73,6 +81,8 @@ impl FitReport {
                 .max_pct
                 .map(|tol| within_tolerance_pct(fitter.point_errors(), fitter.diagonal(), tol)),
             reconstruction: log.reconstruction().cloned(),
+            simplification: log.simplification().cloned(),
+            intake: log.intake_notes(),
             precompute_s,
             fit_s,
             total_s: precompute_s + fit_s,

@@ -109,6 +109,10 @@ struct JsStats {
     tol_avg_pct: Option<f64>,
     tol_max_pct: Option<f64>,
     tol_rms_pct: Option<f64>,
+    /// Surface → data: the largest and 99th-percentile distance of the limit surface to the
+    /// data, % of the diagonal (`null` where not measured).
+    e_back_max_pct: Option<f64>,
+    e_back_p99_pct: Option<f64>,
 }
 
 /// One history entry (camelCase plain object).
@@ -261,7 +265,7 @@ impl Fitter {
     /// totalMs, status, refined, scheme, method, tolAvgPct, tolMaxPct, tolRmsPct}`: the
     /// current errors (in % of the diagonal and model units), the last iteration's time and
     /// flags, and the tolerances in force (`null` where none); status is 'running',
-    /// 'converged' or 'max_iterations'.
+    /// 'converged', 'max_iterations' or 'stalled'.
     pub fn stats(&self) -> Result<JsValue, JsError> {
         let f = self.fit.as_ref();
         let s = f.stats();
@@ -285,6 +289,8 @@ impl Fitter {
             tol_avg_pct: f.tolerances().avg_pct,
             tol_max_pct: f.tolerances().max_pct,
             tol_rms_pct: f.tolerances().rms_pct,
+            e_back_max_pct: f.back_stats().map(|b| b.max_pct),
+            e_back_p99_pct: f.back_stats().map(|b| b.p99_pct),
         };
         to_js(&stats)
     }
@@ -388,6 +394,13 @@ impl Fitter {
     #[wasm_bindgen(js_name = exportStep)]
     pub fn export_step(&self) -> Result<Vec<u8>, JsError> {
         Ok(export::step_of(self.fit.as_ref(), "geofit")?.into_bytes())
+    }
+
+    /// What happened to the data before the first iteration, one line each ("repaired: 3
+    /// non-manifold vertices split", "reconstructed open surface (delaunay): ...").
+    #[wasm_bindgen(js_name = intakeNotes)]
+    pub fn intake_notes(&self) -> Vec<String> {
+        self.fit.log().intake_notes()
     }
 
     /// The fit report (set-up, final errors, times, per-iteration history) as JSON text.

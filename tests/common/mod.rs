@@ -125,3 +125,25 @@ pub fn test_file(name: &str) -> PathBuf {
         .join("tests/data")
         .join(name)
 }
+
+/// The meshes and scans of the shared data and its corpus (`.obj`, `.ply`, `.stl`), sorted, or
+/// `None` (with a message) where the shared data is absent.
+pub fn shared_meshes() -> Option<Vec<PathBuf>> {
+    let data = data_dir();
+    if !data.is_dir() {
+        eprintln!("skipped: no shared data at {}", data.display());
+        return None;
+    }
+    let mut files = Vec::new();
+    for dir in [data.clone(), data.join("corpus")] {
+        for e in std::fs::read_dir(&dir).into_iter().flatten().flatten() {
+            let p = e.path();
+            let ext = p.extension().and_then(|x| x.to_str()).unwrap_or("");
+            if ["obj", "ply", "stl"].contains(&ext) {
+                files.push(p);
+            }
+        }
+    }
+    files.sort();
+    Some(files)
+}

@@ -172,7 +172,7 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
 fn defaults_help() -> String {
     let mut out = String::from(
         "Defaults by scheme (the core's FitSpec::defaults; `--no-X` turns off a default-on X; \
-         subdivision's initial count and budget come from the data: n/60 initial vertices, \
+         subdivision's initial count and budget come from the data: n/60 initial vertices (at least 200), \
          half the points as budget; a curve is closed when its polyline is):\n",
     );
     for &scheme in Scheme::ALL {
@@ -328,15 +328,10 @@ pub fn run(args: Args) -> Result<(), String> {
 
 /// Iterates to the end, printing one line per iteration unless quiet, then the summary.
 fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
-    if let (false, Some(r)) = (args.quiet, fitter.log().reconstruction()) {
-        outln!(
-            "reconstructed {} surface ({}): {} triangles, {} outliers removed, {:.3} s",
-            r.kind,
-            r.method,
-            r.triangles,
-            r.outliers,
-            r.seconds
-        );
+    if !args.quiet {
+        for note in fitter.log().intake_notes() {
+            outln!("{note}");
+        }
     }
     let s = fitter.stats();
     if !args.quiet {
@@ -382,7 +377,11 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
     outln!(
         "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%{}, precompute {:.2} s, fit {:.2} s, total {:.2} s",
         report.scheme,
-        if report.converged { "converged" } else { "stopped" },
+        match report.status {
+            FitStatus::Converged => "converged",
+            FitStatus::Stalled => "stalled",
+            _ => "stopped",
+        },
         report.iterations,
         report.initial_control_points,
         report.final_control_points,

@@ -17,7 +17,9 @@ pub struct Args {
 /// after triangulating polygons and strips; a range scan's grid is reported as
 /// `range_grid: [cols, rows]` and not counted as triangles. The scanner formats with scans
 /// (E57, LAS/LAZ, PTX) add `scans` and `grid_kept` (a file of several scans keeps no grid);
-/// formats that define their unit (E57, glTF/GLB: metres) add `unit_to_metres`.
+/// formats that define their unit (E57, glTF/GLB: metres) add `unit_to_metres`. A mesh adds
+/// `repairs`: what the repair every fit starts with would change ([`geofit::mesh::RepairReport`]:
+/// counts per kind, the first few indices of each, and a one-line `summary`).
 pub fn run(args: Args) -> Result<(), String> {
     let loaded = read_input(&args.file)?;
     let mesh = &loaded.mesh;
@@ -38,6 +40,11 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     if let Some(unit) = loaded.unit_to_metres {
         report["unit_to_metres"] = unit.into();
+    }
+    if !mesh.is_point_cloud() {
+        let repaired =
+            geofit::mesh::repair(mesh).map_err(|e| format!("{}: {e}", args.file.display()))?;
+        report["repairs"] = serde_json::to_value(&repaired.report).map_err(|e| e.to_string())?;
     }
     if !loaded.polylines.is_empty() {
         report["polylines"] = loaded.polylines.len().into();

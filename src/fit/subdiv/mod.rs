@@ -13,6 +13,7 @@ pub(crate) use setup::build_subdiv_fitter;
 pub use setup::{default_initial_count, initial_control, ReconstructionReport};
 
 use super::accel::Accelerator;
+use super::stall::{stalled, STALL_WINDOW};
 use super::{
     Acceleration, DataSurface, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme, Shape,
 };
@@ -82,6 +83,9 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// `options.newton` with its step tolerance in model units.
     newton: NewtonOptions,
     since_refine: usize,
+    /// Whether the last refinement that was due added nothing (the budget left is smaller
+    /// than any split, or nothing was worth splitting).
+    refine_exhausted: bool,
     /// The fairness weight of the next move (see [`SubdivFitter::adapt_fairness`]).
     fairness: f64,
     accel: Accelerator,
@@ -130,6 +134,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .with_step_tol(options.newton.step_tol * diagonal),
             options,
             since_refine: 0,
+            refine_exhausted: false,
             fairness: 0.0,
             accel: Accelerator::new(options.acceleration),
             index,
@@ -526,6 +531,22 @@ impl<S: ControlSurface> SubdivFitter<S> {
         };
     }
 
+    /// Whether the fit cannot refine any more and its errors stopped falling (see
+    /// [`stalled`]).
+    fn is_stalled(&self) -> bool {
+        let can_refine = self.options.refine
+            && self.num_control_points() < self.budget()
+            && !self.refine_exhausted;
+        let history = self.state.log().history();
+        !can_refine
+            && self.since_refine >= STALL_WINDOW
+            && stalled(
+                history,
+                &self.state.tolerances(),
+                self.options.max_iter.saturating_sub(history.len()),
+            )
+    }
+
     fn due_for_refinement(&self, improvement: f64) -> bool {
         self.options.refine
             && self.num_control_points() < self.budget()
@@ -556,16 +577,21 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         let mut refined = false;
         if !self.state.met() && self.due_for_refinement(improvement) {
             refined = self.refine()?;
+            self.refine_exhausted = !refined;
             if refined {
                 self.since_refine = 0;
                 self.measure_back();
             }
         }
-        let status = self
+        let mut status = self
             .state
             .status_after(self.state.met(), self.options.max_iter);
         let n = self.num_control_points();
-        Ok(self.state.record(start, n, refined, status))
+        self.state.record(start, n, refined, status);
+        if status == FitStatus::Running && self.is_stalled() {
+            status = self.state.log_mut().stop(FitStatus::Stalled);
+        }
+        Ok(status)
     }
 
     fn state(&self) -> &FitState {

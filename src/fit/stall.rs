@@ -1,0 +1,110 @@
+//! When to give up: a fit whose control budget is spent and whose errors have stopped falling
+//! says so (status `stalled`, SPEC §6) instead of running to the iteration cap.
+
+use super::{IterationRecord, Tolerances, BACK_TOLERANCE_FACTOR};
+
+/// Iterations over which progress is judged.
+pub(crate) const STALL_WINDOW: usize = 10;
+
+/// The least relative fall of an unmet statistic's best value over [`STALL_WINDOW`] iterations
+/// that counts as progress.
+const MIN_GAIN: f64 = 0.01;
+
+/// One figure of an iteration record, where it has it.
+type Statistic = fn(&IterationRecord) -> Option<f64>;
+
+/// Whether the fit recorded in `history` is stalled: some statistic that misses its tolerance
+/// has not improved its best value by [`MIN_GAIN`] over the last [`STALL_WINDOW`] iterations,
+/// or improves so slowly that, at that rate, it would not meet its tolerance within
+/// `remaining` more iterations. A fit is only stalled when nothing else can change its course,
+/// so the caller asks only when no refinement is left and the last one is a window back.
+pub(crate) fn stalled(
+    history: &[IterationRecord],
+    tolerances: &Tolerances,
+    remaining: usize,
+) -> bool {
+    if history.len() <= STALL_WINDOW {
+        return false;
+    }
+    let (before, _) = history.split_at(history.len() - STALL_WINDOW);
+    let statistics: [(Option<f64>, Statistic); 4] = [
+        (tolerances.avg_pct, |r| Some(r.e_avg_pct)),
+        (tolerances.max_pct, |r| Some(r.e_max_pct)),
+        (tolerances.rms_pct, |r| Some(r.e_rms_pct)),
+        (tolerances.max_pct.map(|t| t * BACK_TOLERANCE_FACTOR), |r| {
+            r.e_back_max_pct
+        }),
+    ];
+    statistics.into_iter().any(|(tol, value)| {
+        let Some(tol) = tol else { return false };
+        let best = |records: &[IterationRecord]| {
+            records
+                .iter()
+                .filter_map(value)
+                .filter(|v| v.is_finite())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let (old, now) = (best(before), best(history));
+        if !(now > tol && old.is_finite()) {
+            return false;
+        }
+        let ratio = now / old;
+        if ratio > 1.0 - MIN_GAIN {
+            return true;
+        }
+        // Windows needed at this rate: ratio^k · now = tol.
+        let windows = (tol / now).ln() / ratio.ln();
+        windows * STALL_WINDOW as f64 > remaining as f64
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(iter: usize, e_max_pct: f64) -> IterationRecord {
+        IterationRecord {
+            iter,
+            control_points: 10,
+            e_avg_pct: 0.0,
+            e_max_pct,
+            e_rms_pct: 0.0,
+            ms: 1.0,
+            refined: false,
+            e_back_max_pct: None,
+            e_back_p99_pct: None,
+        }
+    }
+
+    fn tol(max: f64) -> Tolerances {
+        Tolerances {
+            avg_pct: None,
+            max_pct: Some(max),
+            rms_pct: None,
+        }
+    }
+
+    #[test]
+    fn a_flat_error_is_stalled_a_falling_one_is_not() {
+        let flat: Vec<_> = (1..=20).map(|i| record(i, 0.5)).collect();
+        assert!(stalled(&flat, &tol(0.1), 100));
+        assert!(!stalled(&flat[..STALL_WINDOW], &tol(0.1), 100), "too early");
+        assert!(!stalled(&flat, &tol(0.6), 100), "met");
+        // Halving every 10 iterations, at 0.125 after 20: 0.01 takes ~36 more iterations.
+        let falling: Vec<_> = (1..=20)
+            .map(|i| record(i, 0.5 * 0.5f64.powf(i as f64 / 10.0)))
+            .collect();
+        assert!(!stalled(&falling, &tol(0.01), 100));
+        assert!(stalled(&falling, &tol(0.01), 30), "too slow for the cap");
+    }
+
+    #[test]
+    fn the_surface_to_data_error_counts_at_its_own_bound() {
+        let mut h: Vec<_> = (1..=20).map(|i| record(i, 0.01)).collect();
+        for r in &mut h {
+            r.e_back_max_pct = Some(0.5);
+        }
+        assert!(stalled(&h, &tol(0.1), 100));
+        assert!(!stalled(&h, &tol(0.3), 100), "0.5 is within 2 × 0.3");
+    }
+}
