@@ -254,3 +254,49 @@ fn degenerate_triangles_and_lone_vertices_still_give_unit_normals() {
         assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-6);
     }
 }
+
+#[test]
+fn a_fitted_surface_exports_with_its_deviation_and_figures() {
+    use geofit::fit::{FitData, FitSpec, Scheme};
+    let data = bumpy_grid(16);
+    let mut spec = FitSpec::new(Scheme::Loop);
+    spec.initial = Some(40);
+    spec.max_iter = Some(3);
+    let mut fitter = spec.build(&FitData::points(&data)).expect("fitter");
+    fitter.run().expect("run");
+    let glb = geofit::export::glb_of(fitter.as_ref(), Some(0.001)).expect("glb");
+    save("fit-loop.glb", &glb);
+    let doc = json_of(&glb);
+    let attributes = &doc["meshes"][0]["primitives"][0]["attributes"];
+    for name in ["POSITION", "NORMAL", "COLOR_0", "_DEVIATION"] {
+        assert!(attributes[name].is_u64(), "{name} in {attributes}");
+    }
+    let extras = &doc["scenes"][0]["extras"];
+    assert_eq!(extras["scheme"], "loop");
+    assert!(extras["e_max_pct"].as_f64().is_some_and(f64::is_finite));
+    assert!(extras.get("history").is_none());
+    assert_eq!(doc["nodes"][0]["scale"][0].as_f64(), Some(0.001));
+    // Deviations are the data's signed errors, at most E_max in size.
+    let dev = floats(
+        &glb,
+        &doc,
+        attributes["_DEVIATION"].as_u64().unwrap() as usize,
+    );
+    let e_max = fitter.stats().e_max;
+    assert!(dev.iter().any(|&d| d != 0.0));
+    assert!(dev
+        .iter()
+        .all(|&d| f64::from(d.abs()) <= e_max * (1.0 + 1e-6) + 1e-9));
+    // A curve has no surface to export.
+    let line = PolyMesh::from_points(
+        (0..20)
+            .map(|i| Point3::new(f64::from(i), 0.0, 0.0))
+            .collect(),
+    )
+    .expect("points");
+    let curve = FitSpec::new(Scheme::BsplineCurve)
+        .build(&FitData::points(&line))
+        .expect("curve");
+    let err = geofit::export::glb_of(curve.as_ref(), None).expect_err("no surface");
+    assert!(err.to_string().contains("no surface"), "{err}");
+}

@@ -25,6 +25,7 @@ export { drawChart, errorColors } from './fit-view.js';
 const DOWNLOADS = {
   cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
   ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
+  glb: ['geofit-surface.glb', 'model/gltf-binary'],
   iges: ['geofit.igs', 'model/iges'], step: ['geofit.stp', 'model/step'],
   json: ['geofit-report.json', 'application/json'],
 };

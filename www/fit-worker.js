@@ -92,6 +92,7 @@ const EXPORTS = {
   obj: (f) => f.exportObj(),
   ply: (f) => f.exportPly(),
   stl: (f) => f.exportStl(),
+  glb: (f) => f.exportGlb(),
   iges: (f) => f.exportIges(),
   step: (f) => f.exportStep(),
   json: (f) => new TextEncoder().encode(f.reportJson()),

@@ -3,19 +3,22 @@
 //! refuse the same exports with the same messages.
 
 use super::{iges::write_iges, step::write_step, CurveDesc, ExportError, ExportModel, SurfaceDesc};
-use crate::fit::{Fitter, Scheme, Shape, Spline};
+use crate::fit::{FitReport, Fitter, Scheme, Shape, Spline};
 use crate::geom::Point3;
+use crate::io::{to_glb_bytes, GlbOptions};
 use crate::mesh::PolyMesh;
 use crate::spline::BSplineSurface;
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use kiddo::SquaredEuclidean;
 
-/// The exports a fit of `scheme` offers: `cage` and `json` always, `obj`/`ply`/`stl` for
+/// The exports a fit of `scheme` offers: `cage` and `json` always, `obj`/`ply`/`stl`/`glb` for
 /// surfaces, `iges`/`step` for B-splines.
 pub fn exports_for(scheme: Scheme) -> &'static [&'static str] {
     match scheme {
         Scheme::Loop | Scheme::CatmullClark | Scheme::DooSabin => {
-            &["cage", "obj", "ply", "stl", "json"]
+            &["cage", "obj", "ply", "stl", "glb", "json"]
         }
-        Scheme::BsplineSurface => &["cage", "obj", "ply", "stl", "iges", "step", "json"],
+        Scheme::BsplineSurface => &["cage", "obj", "ply", "stl", "glb", "iges", "step", "json"],
         Scheme::BsplineCurve | Scheme::ChaikinCurve => &["cage", "iges", "step", "json"],
     }
 }
@@ -83,6 +86,57 @@ pub fn surface_mesh(fit: &dyn Fitter) -> Result<PolyMesh, ExportError> {
             ),
         }),
     }
+}
+
+/// The fitted surface as GLB (binary glTF 2.0): [`surface_mesh`] with normals, the signed
+/// deviation of every vertex as `COLOR_0` (diverging scale, white within the E_max tolerance
+/// band fading to red above and blue below) and as the `_DEVIATION` attribute, and the fit's
+/// figures (the report without its history) in the scene's `extras`. A vertex's deviation is
+/// that of the data point whose foot point is nearest to it, so the colours show the data's
+/// errors where they are on the surface. `unit_to_metres` (from the input file, when its
+/// format says) scales the node so viewers show metres.
+pub fn glb_of(fit: &dyn Fitter, unit_to_metres: Option<f64>) -> Result<Vec<u8>, ExportError> {
+    let mesh = surface_mesh(fit)?;
+    let deviation = vertex_deviation(&mesh, &fit.foot_points(), fit.point_errors());
+    let mut figures =
+        serde_json::to_value(FitReport::of(fit)).map_err(|e| ExportError::Invalid {
+            what: "fit report".into(),
+            reason: e.to_string(),
+        })?;
+    if let Some(map) = figures.as_object_mut() {
+        map.remove("history");
+    }
+    let mut options = GlbOptions::default()
+        .with_deviation(&deviation)
+        .with_extras(&figures);
+    if let Some(tol) = fit.tolerances().max_pct {
+        options = options.with_tolerance(tol / 100.0 * fit.diagonal());
+    }
+    if let Some(unit) = unit_to_metres {
+        options = options.with_unit_to_metres(unit);
+    }
+    to_glb_bytes(&mesh, &options).map_err(|e| ExportError::Unsupported {
+        what: e.to_string(),
+    })
+}
+
+/// The signed error of the data point whose foot point is nearest to each vertex of `mesh`
+/// (0 everywhere without data).
+fn vertex_deviation(mesh: &PolyMesh, feet: &[Point3], errors: &[f64]) -> Vec<f64> {
+    let n = mesh.num_vertices();
+    if feet.is_empty() || feet.len() != errors.len() {
+        return vec![0.0; n];
+    }
+    let f32s = |p: &Point3| [p.x as f32, p.y as f32, p.z as f32];
+    let at: Vec<[f32; 3]> = feet.iter().map(f32s).collect();
+    let tree: ImmutableKdTree<f32, u32, 3, 32> = ImmutableKdTree::new_from_slice(&at);
+    mesh.positions()
+        .iter()
+        .map(|p| {
+            let near = tree.nearest_one::<SquaredEuclidean>(&f32s(p));
+            errors.get(near.item as usize).copied().unwrap_or(0.0)
+        })
+        .collect()
 }
 
 /// The control net as OBJ text: the cage of a subdivision surface (load it with the same

@@ -12,7 +12,7 @@ pub mod iges;
 pub mod step;
 
 pub use fitted::{
-    cad_model, cage_obj, exports_for, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION,
+    cad_model, cage_obj, exports_for, glb_of, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION,
 };
 
 use crate::geom::Point3;

@@ -228,6 +228,8 @@ impl MeshArrays {
 pub struct Fitter {
     fit: Box<dyn CoreFitter>,
     initial: MeshArrays,
+    /// Metres per unit of the scan, when its format says (for the GLB export).
+    unit_to_metres: Option<f64>,
 }
 
 #[wasm_bindgen]
@@ -239,7 +241,11 @@ impl Fitter {
         let spec = spec_from_js(options)?;
         let fit = spec.build(&scan.fit_data())?;
         let initial = MeshArrays::of(&fit.control_shape());
-        Ok(Fitter { fit, initial })
+        Ok(Fitter {
+            fit,
+            initial,
+            unit_to_metres: scan.unit_to_metres(),
+        })
     }
 
     /// Runs one iteration (unless the fit has already stopped) and returns the statistics.
@@ -385,6 +391,14 @@ impl Fitter {
 
     /// The fitted B-spline surface or curve as IGES 5.3 bytes (entity 128 or 126); throws for
     /// subdivision schemes.
+    /// The surface as GLB (binary glTF): triangles, normals, the signed deviation as vertex
+    /// colours and as `_DEVIATION`, the fit's figures in `extras`, in metres when the file's
+    /// unit is known.
+    #[wasm_bindgen(js_name = exportGlb)]
+    pub fn export_glb(&self) -> Result<Vec<u8>, JsError> {
+        Ok(export::glb_of(self.fit.as_ref(), self.unit_to_metres)?)
+    }
+
     #[wasm_bindgen(js_name = exportIges)]
     pub fn export_iges(&self) -> Result<Vec<u8>, JsError> {
         Ok(export::iges_of(self.fit.as_ref(), "geofit")?.into_bytes())

@@ -23,6 +23,11 @@ impl LoadedScan {
     pub(crate) fn fit_data(&self) -> crate::fit::FitData<'_> {
         crate::fit::FitData::from(&self.file)
     }
+
+    /// Metres per unit of the file's coordinates, when its format says (E57, glTF/GLB).
+    pub(crate) fn unit_to_metres(&self) -> Option<f64> {
+        self.file.unit_to_metres
+    }
 }
 
 #[wasm_bindgen]

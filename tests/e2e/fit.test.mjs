@@ -6,6 +6,7 @@
 // example of the README.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
+import { validateBytes } from 'gltf-validator';
 import { readFileSync } from 'node:fs';
 import { startServer } from '../../scripts/serve.mjs';
 import { join } from 'node:path';
@@ -222,10 +223,14 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
 
   test('exports download and re-read through loadFile', async () => {
     const tag = `${backend.name}-loop`;
-    for (const [what, name] of [['obj', 'a.obj'], ['ply', 'a.ply'], ['stl', 'a.stl'], ['cage', 'c.obj']]) {
+    for (const [what, name] of [['obj', 'a.obj'], ['ply', 'a.ply'], ['stl', 'a.stl'], ['cage', 'c.obj'], ['glb', 'a.glb']]) {
       const { bytes } = await exportBytes(page, what, tag);
       const counts = await reread(page, bytes, name);
       assert.ok(counts.points > 0 && counts.triangles > 0, `${what}: ${JSON.stringify(counts)}`);
+      if (what === 'glb') {
+        const result = await validateBytes(new Uint8Array(bytes));
+        assert.equal(result.issues.numErrors, 0, JSON.stringify(result.issues.messages.slice(0, 5)));
+      }
     }
     assert.ok(await page.isDisabled('[data-export="iges"]'), 'no IGES for a subdivision surface');
     assert.ok(await page.isDisabled('[data-export="step"]'), 'no STEP for a subdivision surface');

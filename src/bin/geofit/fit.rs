@@ -141,6 +141,11 @@ pub struct Args {
     /// JSON.
     #[arg(long)]
     surface_json: Option<PathBuf>,
+    /// Surface: export as GLB (binary glTF: triangles, normals, the signed deviation as vertex
+    /// colours and as `_DEVIATION`, the fit's figures in `extras`, metres when the input's unit
+    /// is known).
+    #[arg(long)]
+    glb: Option<PathBuf>,
     /// B-spline surface or curve: export as IGES 5.3.
     #[arg(long)]
     iges: Option<PathBuf>,
@@ -259,6 +264,7 @@ impl Args {
             ("--iges", self.iges.is_some(), spline),
             ("--step", self.step.is_some(), spline),
             ("--limit", self.limit.is_some(), !s.is_curve()),
+            ("--glb", self.glb.is_some(), !s.is_curve()),
             (
                 "--surface-json",
                 self.surface_json.is_some(),
@@ -323,7 +329,7 @@ pub fn run(args: Args) -> Result<(), String> {
         .map_err(|e| format!("{}: {}", args.file.display(), cli_error(e)))?;
     fitter.log_mut().add_precompute(read_s);
     drive(fitter.as_mut(), &args)?;
-    write_outputs(fitter.as_ref(), &args)
+    write_outputs(fitter.as_ref(), &args, file.unit_to_metres)
 }
 
 /// Iterates to the end, printing one line per iteration unless quiet, then the summary.
@@ -397,7 +403,11 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
 }
 
 /// Writes the files asked for.
-fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
+fn write_outputs(
+    fitter: &dyn Fitter,
+    args: &Args,
+    unit_to_metres: Option<f64>,
+) -> Result<(), String> {
     let name = args
         .file
         .file_stem()
@@ -405,7 +415,7 @@ fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
         .unwrap_or("geofit");
     let text = |r: Result<String, export::ExportError>| r.map(String::into_bytes);
     type Make<'a> = Box<dyn Fn() -> Result<Vec<u8>, String> + 'a>;
-    let outputs: [(&Option<PathBuf>, Make); 6] = [
+    let outputs: [(&Option<PathBuf>, Make); 7] = [
         (
             &args.json,
             Box::new(|| json_text(&FitReport::of(fitter), true)),
@@ -427,6 +437,10 @@ fn write_outputs(fitter: &dyn Fitter, args: &Args) -> Result<(), String> {
             Box::new(|| text(export::step_of(fitter, name)).map_err(|e| e.to_string())),
         ),
         (&args.surface_json, Box::new(|| surface_json(fitter))),
+        (
+            &args.glb,
+            Box::new(|| export::glb_of(fitter, unit_to_metres).map_err(|e| e.to_string())),
+        ),
     ];
     for (path, make) in outputs {
         if let Some(path) = path {
