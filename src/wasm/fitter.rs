@@ -389,16 +389,16 @@ impl Fitter {
         Ok(export::cage_obj(self.fit.as_ref())?)
     }
 
-    /// The fitted B-spline surface or curve as IGES 5.3 bytes (entity 128 or 126); throws for
-    /// subdivision schemes.
     /// The surface as GLB (binary glTF): triangles, normals, the signed deviation as vertex
     /// colours and as `_DEVIATION`, the fit's figures in `extras`, in metres when the file's
-    /// unit is known.
+    /// unit is known; throws for curves.
     #[wasm_bindgen(js_name = exportGlb)]
     pub fn export_glb(&self) -> Result<Vec<u8>, JsError> {
         Ok(export::glb_of(self.fit.as_ref(), self.unit_to_metres)?)
     }
 
+    /// The fitted B-spline surface or curve as IGES 5.3 bytes (entity 128 or 126); throws for
+    /// subdivision schemes.
     #[wasm_bindgen(js_name = exportIges)]
     pub fn export_iges(&self) -> Result<Vec<u8>, JsError> {
         Ok(export::iges_of(self.fit.as_ref(), "geofit")?.into_bytes())
