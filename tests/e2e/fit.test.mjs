@@ -427,6 +427,38 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     assert.match(messages[9], /initial/);
   });
 
+  test('user files from the corpus fit with no setting touched; repairs are listed', async () => {
+    // A fresh page, nothing edited: the form holds what the page starts with (the first
+    // sample's preset tolerances, 0.1 % / 0.5 %) and the core's defaults for the rest.
+    const fresh = await browser.newPage({ viewport: { width: 1100, height: 800 } });
+    try {
+      fresh.on('pageerror', (e) => problems.push(`corpus page error: ${e.message}`));
+      await fresh.goto(page.url());
+      await fresh.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
+      const data = join(ROOT, '..', 'shared', 'data');
+      const files = [
+        ['corpus/woody.obj', null],
+        ['teapot.obj', /repaired: 38 non-manifold vertices split/],
+        ['corpus/beetle.obj', /faces detached from non-manifold edges/],
+      ];
+      for (const [file, repaired] of files) {
+        await fresh.setInputFiles('#file', { name: file.split('/').pop(), mimeType: 'model/obj', buffer: readFileSync(join(data, file)) });
+        await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+        const stats = await playToEnd(fresh);
+        console.log(`[e2e] ${backend.name} ${file}: ${JSON.stringify(stats)}`);
+        assert.equal(stats.status, 'converged', file);
+        assert.ok(Number.isFinite(stats.eMaxPct) && Number.isFinite(stats.eBackMaxPct), JSON.stringify(stats));
+        assert.match(await fresh.textContent('#fit-eback'), /%/);
+        if (repaired) {
+          assert.equal(await fresh.isHidden('#fit-intake'), false);
+          assert.match(await fresh.textContent('#fit-intake'), repaired);
+        }
+      }
+    } finally {
+      await fresh.close();
+    }
+  });
+
   test('keyboard: arrow keys turn the focused view; every control has a label', async () => {
     const before = await page.locator('#view').screenshot();
     await page.focus('#view');
