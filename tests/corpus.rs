@@ -89,6 +89,11 @@ fn problems(report: &Value) -> Vec<String> {
             }
         }
     }
+    // A fit that ends with its mean error a tenth of the object has broken down (a bad split
+    // once took Doo–Sabin on fandisk's points to E_avg 7e9 %).
+    if report["e_avg_pct"].as_f64().is_some_and(|e| e > 10.0) {
+        found.push(format!("E_avg {} % of the diagonal", report["e_avg_pct"]));
+    }
     let status = report["status"].as_str().unwrap_or("");
     if !["converged", "stalled", "max_iterations"].contains(&status) {
         found.push(format!("status {status:?}"));

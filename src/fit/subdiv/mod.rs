@@ -25,6 +25,11 @@ use index::SurfaceIndex;
 use std::collections::HashSet;
 use web_time::Instant;
 
+/// A refinement after which E_rms is more than this many times what it was is undone: a
+/// refinement changes the surface little (Loop's and Catmull–Clark's splits not at all away
+/// from the split faces), so such a jump means a broken split, not a worse fit.
+const REFINE_WORSE_FACTOR: f64 = 2.0;
+
 /// Below this share of the option's weight the fairness is switched off altogether.
 const FAIRNESS_FLOOR: f64 = 1e-6;
 
@@ -406,10 +411,20 @@ impl<S: ControlSurface> SubdivFitter<S> {
                     self.surface.remesh_control(&mut refined)?;
                 }
                 let old_faces = self.patch_faces_now(&control);
+                let before = self.state.stats().e_rms;
                 self.surface = self.surface.rebuild(&refined)?;
                 self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
                 self.accel.reset();
                 self.carry_feet_over(&old_faces, &refined)?;
+                let after = self.state.stats().e_rms;
+                if after.is_nan() || after > REFINE_WORSE_FACTOR * before {
+                    // A split that breaks the surface (seen with Doo–Sabin on open meshes): back
+                    // to the control mesh before it, and no more refinement.
+                    self.surface = self.surface.rebuild(&control)?;
+                    self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
+                    self.search_all_feet()?;
+                    return Ok(false);
+                }
                 return Ok(true);
             }
             if last_size == Some(refined.num_vertices()) {
