@@ -43,6 +43,7 @@ import numpy as np
 import pye57
 import pygltflib
 from pypcd4 import Encoding, PointCloud
+import objfile
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "tests" / "data" / "formats"
@@ -83,18 +84,8 @@ def read_bun000(path: Path):
 
 
 def read_obj(path: Path):
-    verts, faces = [], []
-    for line in path.read_text().splitlines():
-        parts = line.split()
-        if not parts:
-            continue
-        if parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts[0] == "f":
-            idx = [int(p.split("/")[0]) - 1 for p in parts[1:]]
-            for k in range(1, len(idx) - 1):
-                faces.append([idx[0], idx[k], idx[k + 1]])
-    return np.array(verts), np.array(faces, dtype=np.uint32)
+    verts, faces = objfile.read_obj(path)
+    return verts, np.array(faces, dtype=np.uint32)
 
 
 def f32(a):

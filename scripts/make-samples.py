@@ -15,6 +15,8 @@ from pathlib import Path
 import fast_simplification
 import numpy as np
 
+import objfile
+
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "www" / "samples"
 TARGET_VERTICES = 2000
@@ -29,18 +31,8 @@ def data_dir() -> Path:
 
 
 def read_obj(path: Path):
-    verts, faces = [], []
-    for line in path.read_text().splitlines():
-        parts = line.split()
-        if not parts:
-            continue
-        if parts[0] == "v":
-            verts.append([float(x) for x in parts[1:4]])
-        elif parts[0] == "f":
-            idx = [int(p.split("/")[0]) for p in parts[1:]]
-            idx = [i - 1 if i > 0 else len(verts) + i for i in idx]
-            faces.extend([idx[0], idx[k], idx[k + 1]] for k in range(1, len(idx) - 1))
-    return np.array(verts, dtype=np.float64), np.array(faces, dtype=np.int64)
+    verts, faces = objfile.read_obj(path)
+    return verts, np.array(faces, dtype=np.int64)
 
 
 def write_bunny(data: Path) -> None:

@@ -9,21 +9,7 @@ longest loop as two columns (the two other coordinates, in x, y, z order).
 import sys
 import numpy as np
 
-
-def read_obj(path):
-    verts, faces = [], []
-    with open(path) as f:
-        for line in f:
-            parts = line.split()
-            if not parts:
-                continue
-            if parts[0] == "v":
-                verts.append([float(x) for x in parts[1:4]])
-            elif parts[0] == "f":
-                idx = [int(p.split("/")[0]) - 1 for p in parts[1:]]
-                for k in range(1, len(idx) - 1):
-                    faces.append((idx[0], idx[k], idx[k + 1]))
-    return np.array(verts), faces
+from objfile import read_obj
 
 
 def section_loops(verts, faces, axis, level):

@@ -26,6 +26,9 @@ from collections import defaultdict, deque
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "..", "scripts"))
+import objfile  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 DATA = os.environ.get("GEOFIT_DATA", os.path.join(HERE, "..", "..", "..", "..", "shared", "data"))
 if not os.path.isdir(DATA):
@@ -33,16 +36,8 @@ if not os.path.isdir(DATA):
 
 
 def read_obj(path):
-    V, F = [], []
-    for line in open(path):
-        t = line.split()
-        if not t:
-            continue
-        if t[0] == "v":
-            V.append([float(x) for x in t[1:4]])
-        elif t[0] == "f":
-            F.append([int(x.split("/")[0]) - 1 for x in t[1:]])
-    return np.array(V), F
+    """Vertices and polygons (not triangulated) of an OBJ file."""
+    return objfile.read_obj(path, triangulate=False)
 
 
 def write_obj(path, V, F):
