@@ -30,7 +30,7 @@ run_e2e() {
 
 run_interop() {
     shopt -s nullglob
-    local files=(tests/interop/*.py)
+    local files=(tests/interop/test_*.py)
     if ((${#files[@]} == 0)); then
         echo "no interop tests"
         return

@@ -24,18 +24,10 @@ from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
 
-REPO = Path(__file__).resolve().parents[2]
+from geofit_cli import REPO, geofit_bin
+
 REL_TOL = 1e-9
 
-
-def geofit_bin():
-    env = os.environ.get("GEOFIT_BIN")
-    if env:
-        return env
-    path = REPO / "target" / "release" / "geofit"
-    if not path.exists():
-        subprocess.run(["cargo", "build", "--release", "--bin", "geofit"], cwd=REPO, check=True)
-    return str(path)
 
 
 def read_shape(path):

@@ -21,19 +21,11 @@ import numpy as np
 import pymeshlab
 from scipy.spatial import cKDTree
 
-REPO = Path(__file__).resolve().parents[2]
+from geofit_cli import REPO, geofit_bin
+
 DATA = REPO / "tests" / "data" / "subdiv"
 TOL = 1e-12
 
-
-def geofit_bin():
-    env = os.environ.get("GEOFIT_BIN")
-    if env:
-        return env
-    path = REPO / "target" / "release" / "geofit"
-    if not path.exists():
-        subprocess.run(["cargo", "build", "--release", "--bin", "geofit"], cwd=REPO, check=True)
-    return str(path)
 
 
 def read_vertices(path):
