@@ -4,8 +4,9 @@
 
 mod common;
 
+use common::fuzz::{apply, cases, check_consistent, edit, read_checked};
 use geofit::geom::Point3;
-use geofit::io::{read_bytes, to_ply_bytes, LoadedFile};
+use geofit::io::{read_bytes, to_ply_bytes};
 use geofit::mesh::PolyMesh;
 use proptest::prelude::*;
 
@@ -65,107 +66,21 @@ fn samples() -> Vec<(&'static str, Vec<u8>)> {
     ]
 }
 
-/// What must hold for anything a reader accepts.
-fn check_consistent(f: &LoadedFile) {
-    let n = f.mesh.num_vertices();
-    assert!(n > 0);
-    assert!(f.mesh.positions().iter().all(|p| p.is_finite()));
-    assert!(f
-        .mesh
-        .faces()
-        .all(|face| face.iter().all(|&i| (i as usize) < n)));
-    assert!(f.polylines.iter().flatten().all(|&i| (i as usize) < n));
-    if let Some(g) = &f.range_grid {
-        assert!(g.triangles().iter().flatten().all(|&i| (i as usize) < n));
-    }
-    assert!(f.dimension == 2 || f.dimension == 3);
-}
-
-fn read_checked(bytes: &[u8], name: Option<&str>) {
-    match read_bytes(bytes, name) {
-        Ok(f) => check_consistent(&f),
-        Err(e) => assert!(!e.to_string().is_empty()),
-    }
-}
-
-/// `$PROPTEST_CASES` when set (for a deeper run), else `default`.
-fn cases(default: u32) -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
-#[derive(Debug, Clone)]
-enum Edit {
-    Set(usize, u8),
-    Insert(usize, Vec<u8>),
-    Remove(usize, usize),
-    /// Replace the n-th run of ASCII digits with another number.
-    Number(usize, u64),
-}
-
-fn edit() -> impl Strategy<Value = Edit> {
-    let word = prop::sample::select(vec![
-        &b"-1"[..],
-        b" ",
-        b"\n",
-        b"nan",
-        b"inf",
-        b"1e309",
-        b"4294967295",
-        b"-",
-        b"/",
-        b"list",
-        b"end_header\n",
-        b"\r\n",
-    ]);
-    prop_oneof![
-        (any::<usize>(), any::<u8>()).prop_map(|(i, b)| Edit::Set(i, b)),
-        (any::<usize>(), word).prop_map(|(i, w)| Edit::Insert(i, w.to_vec())),
-        (any::<usize>(), 1usize..16).prop_map(|(i, n)| Edit::Remove(i, n)),
-        (any::<usize>(), any::<u64>()).prop_map(|(i, v)| Edit::Number(i, v)),
-    ]
-}
-
-fn apply(bytes: &mut Vec<u8>, e: &Edit) {
-    let len = bytes.len().max(1);
-    match e {
-        Edit::Set(i, b) if !bytes.is_empty() => bytes[i % len] = *b,
-        Edit::Insert(i, w) => {
-            let at = i % (bytes.len() + 1);
-            bytes.splice(at..at, w.iter().copied());
-        }
-        Edit::Remove(i, n) if !bytes.is_empty() => {
-            let at = i % len;
-            bytes.drain(at..(at + n).min(bytes.len()));
-        }
-        Edit::Number(k, v) => {
-            let runs: Vec<(usize, usize)> = digit_runs(bytes);
-            if let Some(&(s, t)) = runs.get(k % runs.len().max(1)) {
-                bytes.splice(s..t, v.to_string().into_bytes());
-            }
-        }
-        _ => {}
-    }
-}
-
-fn digit_runs(bytes: &[u8]) -> Vec<(usize, usize)> {
-    let mut runs = Vec::new();
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i].is_ascii_digit() {
-            let s = i;
-            while i < bytes.len() && bytes[i].is_ascii_digit() {
-                i += 1;
-            }
-            runs.push((s, i));
-        } else {
-            i += 1;
-        }
-    }
-    runs
-}
+/// What the mutations insert: tokens the text readers and the PLY header parse.
+const TEXT_WORDS: [&[u8]; 12] = [
+    b"-1",
+    b" ",
+    b"\n",
+    b"nan",
+    b"inf",
+    b"1e309",
+    b"4294967295",
+    b"-",
+    b"/",
+    b"list",
+    b"end_header\n",
+    b"\r\n",
+];
 
 #[test]
 fn samples_are_valid() {
@@ -196,13 +111,13 @@ proptest! {
     #[test]
     fn mutated_samples_never_panic(
         which in any::<prop::sample::Index>(),
-        edits in prop::collection::vec(edit(), 1..5),
+        edits in prop::collection::vec(edit(TEXT_WORDS.to_vec()), 1..5),
         cut in prop::option::of(any::<prop::sample::Index>()),
     ) {
         let all = samples();
         let (name, mut bytes) = all[which.index(all.len())].clone();
         for e in &edits {
-            apply(&mut bytes, e);
+            apply(&mut bytes, e, None);
         }
         if let Some(cut) = cut {
             bytes.truncate(cut.index(bytes.len() + 1));

@@ -2,6 +2,7 @@
 //! piecewise-linear `LimitSurface` the fitting engine can be checked against.
 #![allow(dead_code)]
 
+pub mod fuzz;
 pub mod linear;
 pub mod manifold;
 pub mod meshes;
