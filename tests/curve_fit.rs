@@ -1,32 +1,11 @@
 //! Geometric curve fitting (SPEC §1.9) on synthetic curves and on the committed sections of the
 //! bunny and the fandisk (tests/data/*_section*.xyz, made by scripts/make_sections.py).
 
-use geofit::fit::{CurveFitOptions, CurveFitter, FitError, FitStatus, Fitter, Tolerances};
+mod common;
+
+use common::{max_only, section};
+use geofit::fit::{CurveFitOptions, CurveFitter, FitError, FitStatus, Fitter};
 use geofit::geom::Point3;
-use std::path::PathBuf;
-
-/// A two-column section file from tests/data as points with z = 0.
-fn section(name: &str) -> Vec<Point3> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name);
-    let text = std::fs::read_to_string(&path).expect("section file");
-    text.lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            Point3::new(v[0], v[1], 0.0)
-        })
-        .collect()
-}
-
-fn max_only(pct: f64) -> Tolerances {
-    Tolerances {
-        avg_pct: None,
-        max_pct: Some(pct),
-        rms_pct: None,
-    }
-}
 
 fn ellipse(n: usize) -> Vec<Point3> {
     (0..n)

@@ -1,35 +1,15 @@
 //! Knot placement with least squares (SPEC §3): exact reproduction, the bunny section, and
 //! sharp corners on the fandisk sections.
 
+mod common;
+
+use common::{max_only, section};
 use geofit::fit::{
     least_squares_curve, CurveFitOptions, CurveFitter, FitStatus, Fitter, KnotPlacementFitter,
-    KnotPlacementOptions, Tolerances,
+    KnotPlacementOptions,
 };
 use geofit::geom::Point3;
 use geofit::spline::BSplineCurve;
-use std::path::PathBuf;
-
-fn section(name: &str) -> Vec<Point3> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name);
-    let text = std::fs::read_to_string(&path).expect("section file");
-    text.lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
-            Point3::new(v[0], v[1], 0.0)
-        })
-        .collect()
-}
-
-fn max_only(pct: f64) -> Tolerances {
-    Tolerances {
-        avg_pct: None,
-        max_pct: Some(pct),
-        rms_pct: None,
-    }
-}
 
 #[test]
 fn least_squares_reproduces_an_exact_bspline() {

@@ -148,3 +148,25 @@ pub fn shared_meshes() -> Option<Vec<PathBuf>> {
     files.sort();
     Some(files)
 }
+
+/// A two-column section file of `tests/data` (made by scripts/make_sections.py) as points with
+/// z = 0.
+pub fn section(name: &str) -> Vec<Point3> {
+    let text = std::fs::read_to_string(test_file(name)).expect("section file");
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            Point3::new(v[0], v[1], 0.0)
+        })
+        .collect()
+}
+
+/// Tolerances with only an E_max bound, in % of the diagonal.
+pub fn max_only(pct: f64) -> geofit::fit::Tolerances {
+    geofit::fit::Tolerances {
+        avg_pct: None,
+        max_pct: Some(pct),
+        rms_pct: None,
+    }
+}
