@@ -1,5 +1,7 @@
 //! `geofit fit --scheme bspline-curve` end to end: report fields, exports, and clear failures on bad input.
 
+mod common;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -13,30 +15,25 @@ fn fit_curve_reports_and_exports() {
     std::fs::create_dir_all(&dir).unwrap();
     for method in ["geometric", "knots"] {
         let json = dir.join(format!("{method}.json"));
-        let out = Command::new(env!("CARGO_BIN_EXE_geofit"))
-            .arg("fit")
-            .arg(repo().join("tests/data/fandisk_section_x.xyz"))
-            .args([
-                "--scheme",
-                "bspline-curve",
-                "--closed",
-                "--method",
-                method,
-                "--tol-max",
-                "0.01",
-                "--json",
-            ])
-            .arg(&json)
-            .arg("--iges")
-            .arg(dir.join(format!("{method}.igs")))
-            .arg("--step")
-            .arg(dir.join(format!("{method}.stp")))
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        common::run_ok(
+            &mut Command::new(env!("CARGO_BIN_EXE_geofit"))
+                .arg("fit")
+                .arg(repo().join("tests/data/fandisk_section_x.xyz"))
+                .args([
+                    "--scheme",
+                    "bspline-curve",
+                    "--closed",
+                    "--method",
+                    method,
+                    "--tol-max",
+                    "0.01",
+                    "--json",
+                ])
+                .arg(&json)
+                .arg("--iges")
+                .arg(dir.join(format!("{method}.igs")))
+                .arg("--step")
+                .arg(dir.join(format!("{method}.stp"))),
         );
         let r: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();

@@ -170,3 +170,14 @@ pub fn max_only(pct: f64) -> geofit::fit::Tolerances {
         rms_pct: None,
     }
 }
+
+/// Runs `command` and returns its output, failing the test with its stderr when it fails.
+pub fn run_ok(command: &mut std::process::Command) -> std::process::Output {
+    let out = command.output().expect("the command starts");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
