@@ -16,7 +16,7 @@ fn fit_curve_reports_and_exports() {
     for method in ["geometric", "knots"] {
         let json = dir.join(format!("{method}.json"));
         common::run_ok(
-            &mut Command::new(env!("CARGO_BIN_EXE_geofit"))
+            Command::new(env!("CARGO_BIN_EXE_geofit"))
                 .arg("fit")
                 .arg(repo().join("tests/data/fandisk_section_x.xyz"))
                 .args([
