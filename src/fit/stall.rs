@@ -13,8 +13,9 @@ const MIN_GAIN: f64 = 0.01;
 /// One figure of an iteration record, where it has it.
 type Statistic = fn(&IterationRecord) -> Option<f64>;
 
-/// Whether the fit recorded in `history` is stalled: some statistic that misses its tolerance
-/// has not improved its best value by [`MIN_GAIN`] over the last [`STALL_WINDOW`] iterations,
+/// Whether the fit recorded in `history` is stalled: some statistic whose best value over the
+/// last [`STALL_WINDOW`] iterations misses its tolerance has not improved on the window before
+/// by [`MIN_GAIN`],
 /// or improves so slowly that, at that rate, it would not meet its tolerance within
 /// `remaining` more iterations. A fit is only stalled when nothing else can change its course,
 /// so the caller asks only when no refinement is left and the last one is a window back.
@@ -26,7 +27,10 @@ pub(crate) fn stalled(
     if history.len() <= STALL_WINDOW {
         return false;
     }
-    let (before, _) = history.split_at(history.len() - STALL_WINDOW);
+    // The last window against the one before it: a best value from before a refinement (when
+    // the surface was coarser) says nothing about whether this surface still improves.
+    let (before, last) = history.split_at(history.len() - STALL_WINDOW);
+    let before = &before[before.len().saturating_sub(STALL_WINDOW)..];
     let statistics: [(Option<f64>, Statistic); 4] = [
         (tolerances.avg_pct, |r| Some(r.e_avg_pct)),
         (tolerances.max_pct, |r| Some(r.e_max_pct)),
@@ -44,7 +48,7 @@ pub(crate) fn stalled(
                 .filter(|v| v.is_finite())
                 .fold(f64::INFINITY, f64::min)
         };
-        let (old, now) = (best(before), best(history));
+        let (old, now) = (best(before), best(last));
         if !(now > tol && old.is_finite()) {
             return false;
         }
@@ -96,6 +100,16 @@ mod tests {
             .collect();
         assert!(!stalled(&falling, &tol(0.01), 100));
         assert!(stalled(&falling, &tol(0.01), 30), "too slow for the cap");
+    }
+
+    #[test]
+    fn an_early_best_does_not_hide_a_stall() {
+        // E_back was low on the coarse start, then stays high after a refinement.
+        let mut h: Vec<_> = (1..=30).map(|i| record(i, 0.01)).collect();
+        for r in &mut h {
+            r.e_back_max_pct = Some(if r.iter == 1 { 0.6 } else { 1.17 });
+        }
+        assert!(stalled(&h, &tol(0.5), 100));
     }
 
     #[test]
