@@ -38,6 +38,36 @@ pub struct BackStats {
     pub over_holes: usize,
 }
 
+impl BackStats {
+    /// The statistics of surface → data `distances` (`None`: a sample over a hole), relative
+    /// to a bounding-box `diagonal`.
+    pub fn of(distances: &[Option<f64>], diagonal: f64) -> BackStats {
+        let mut d: Vec<f64> = distances.iter().flatten().copied().collect();
+        let over_holes = distances.len() - d.len();
+        if d.is_empty() {
+            return BackStats {
+                over_holes,
+                ..BackStats::default()
+            };
+        }
+        let pct = if diagonal > 0.0 {
+            100.0 / diagonal
+        } else {
+            0.0
+        };
+        let k = ((d.len() as f64 * 0.99).ceil() as usize).clamp(1, d.len()) - 1;
+        let (_, p99, _) = d.select_nth_unstable_by(k, f64::total_cmp);
+        let p99 = *p99;
+        let max = d.iter().copied().fold(0.0f64, f64::max);
+        BackStats {
+            max_pct: max * pct,
+            p99_pct: p99 * pct,
+            samples: d.len(),
+            over_holes,
+        }
+    }
+}
+
 /// The largest turn of the data's normals across one triangle that [`sagitta`] credits to the
 /// triangle's flatness; more is a crease, which a smooth surface rounds off for real.
 const MAX_TURN: f64 = std::f64::consts::FRAC_PI_6;
@@ -230,32 +260,15 @@ impl DataSurface {
             .then(|| (foot.dist_sq.sqrt() - foot.sagitta).max(0.0))
     }
 
+    /// The distance of every one of `samples` to the data ([`DataSurface::distance`]).
+    pub fn distances(&self, samples: &[Point3]) -> Vec<Option<f64>> {
+        samples.iter().map(|&p| self.distance(p)).collect()
+    }
+
     /// The surface → data statistics of `samples` (points of a fitted surface), relative to a
     /// bounding-box `diagonal`.
     pub fn measure(&self, samples: &[Point3], diagonal: f64) -> BackStats {
-        let mut d: Vec<f64> = samples.iter().filter_map(|&p| self.distance(p)).collect();
-        let over_holes = samples.len() - d.len();
-        if d.is_empty() {
-            return BackStats {
-                over_holes,
-                ..BackStats::default()
-            };
-        }
-        let pct = if diagonal > 0.0 {
-            100.0 / diagonal
-        } else {
-            0.0
-        };
-        let k = ((d.len() as f64 * 0.99).ceil() as usize).clamp(1, d.len()) - 1;
-        let (_, p99, _) = d.select_nth_unstable_by(k, f64::total_cmp);
-        let p99 = *p99;
-        let max = d.iter().copied().fold(0.0f64, f64::max);
-        BackStats {
-            max_pct: max * pct,
-            p99_pct: p99 * pct,
-            samples: d.len(),
-            over_holes,
-        }
+        BackStats::of(&self.distances(samples), diagonal)
     }
 
     /// The nearest point of the data surface, and whether it lies on the data's boundary.

@@ -63,12 +63,15 @@ impl FitState {
         self.reference.is_some()
     }
 
-    /// Measures the surface → data distances of `samples` of the current surface.
-    pub(crate) fn measure_back(&mut self, samples: &[Point3]) {
-        self.back = self
-            .reference
-            .as_ref()
-            .map(|r| r.measure(samples, self.diagonal));
+    /// Measures the surface → data distances of `samples` of the current surface and returns
+    /// them (`None` over a hole; empty when no reference is set).
+    pub(crate) fn measure_back(&mut self, samples: &[Point3]) -> Vec<Option<f64>> {
+        let Some(reference) = &self.reference else {
+            return Vec::new();
+        };
+        let distances = reference.distances(samples);
+        self.back = Some(BackStats::of(&distances, self.diagonal));
+        distances
     }
 
     /// The last surface → data statistics, when they are measured.

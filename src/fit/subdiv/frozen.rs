@@ -66,16 +66,17 @@ impl Fairness {
             .collect()
     }
 
-    /// out += w Uᵀ U x.
-    fn add_normal(&self, x: &[Vec3], w: f64, out: &mut [Vec3]) {
+    /// out += Uᵀ W U x, W the diagonal of per-point weights `w` times `scale`.
+    fn add_normal(&self, x: &[Vec3], w: &[f64], scale: f64, out: &mut [Vec3]) {
         let u = self.umbrella(x);
         for (j, uj) in u.iter().enumerate() {
             let ring = self.ring(j);
-            if ring.is_empty() {
+            let wj = w.get(j).copied().unwrap_or(0.0) * scale;
+            if ring.is_empty() || wj == 0.0 {
                 continue;
             }
-            out[j] += *uj * w;
-            let share = *uj * (w / ring.len() as f64);
+            out[j] += *uj * wj;
+            let share = *uj * (wj / ring.len() as f64);
             for &k in ring {
                 out[k as usize] -= share;
             }
@@ -158,15 +159,16 @@ impl Stencils {
     /// tangential slip that frozen parameters create as the surface moves (w = 1 is the plain
     /// point-to-point problem; smaller w converges faster, as in squared-distance minimisation).
     /// With `fair = Some((fairness, points, λ))` the problem gains the umbrella fairness of the
-    /// control net at `points + Δ`, weighted λ times the median data support of a control point
-    /// (Σ_i B_ij² over the data). Returns the control-point moves Δ.
+    /// control net at `points + Δ`, control point j's umbrella weighted λ_j times the median
+    /// data support of a control point (Σ_i B_ij² over the data). Returns the control-point
+    /// moves Δ.
     pub(crate) fn cg(
         &self,
         e: &[Vec3],
         normals: &[Vec3],
         tangent_weight: f64,
         steps: usize,
-        fair: Option<(&Fairness, &[Point3], f64)>,
+        fair: Option<(&Fairness, &[Point3], &[f64])>,
     ) -> Vec<Vec3> {
         let n = self.columns;
         let metric = |i: usize, v: Vec3| {
@@ -178,9 +180,11 @@ impl Stencils {
         for &(j, w) in &self.entries {
             diag[j as usize] += w * w;
         }
-        let fair = fair.map(|(f, points, lambda)| (f, points, lambda * median(&diag)));
-        if let Some((_, _, w)) = fair {
-            diag.iter_mut().for_each(|d| *d += w);
+        let fair = fair.map(|(f, points, lambda)| (f, points, lambda, median(&diag)));
+        if let Some((_, _, lambda, scale)) = fair {
+            for (d, l) in diag.iter_mut().zip(lambda) {
+                *d += l * scale;
+            }
         }
         let inv: Vec<f64> = diag
             .iter()
@@ -193,11 +197,11 @@ impl Stencils {
         let mut r = vec![Vec3::ZERO; n];
         let me: Vec<Vec3> = e.iter().enumerate().map(|(i, &v)| metric(i, v)).collect();
         self.apply_transposed(&me, &mut r);
-        if let Some((f, points, w)) = fair {
-            // The right-hand side's fairness part: −w Uᵀ U P.
+        if let Some((f, points, lambda, scale)) = fair {
+            // The right-hand side's fairness part: −Uᵀ W U P.
             let p: Vec<Vec3> = points.to_vec();
             let mut up = vec![Vec3::ZERO; n];
-            f.add_normal(&p, w, &mut up);
+            f.add_normal(&p, lambda, scale, &mut up);
             for (rk, uk) in r.iter_mut().zip(&up) {
                 *rk -= *uk;
             }
@@ -208,8 +212,8 @@ impl Stencils {
         let mut ap = vec![Vec3::ZERO; n];
         for _ in 0..steps {
             self.apply_normal(&p, metric, &mut ap);
-            if let Some((f, _, w)) = fair {
-                f.add_normal(&p, w, &mut ap);
+            if let Some((f, _, lambda, scale)) = fair {
+                f.add_normal(&p, lambda, scale, &mut ap);
             }
             let pap = dot(&p, &ap);
             let alpha = rz / pap;

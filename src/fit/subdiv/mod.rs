@@ -15,7 +15,8 @@ pub use setup::{default_initial_count, initial_control, ReconstructionReport};
 use super::accel::Accelerator;
 use super::stall::{stalled, STALL_WINDOW};
 use super::{
-    Acceleration, DataSurface, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme, Shape,
+    Acceleration, DataSurface, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme,
+    Shape, BACK_TOLERANCE_FACTOR,
 };
 use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
@@ -30,8 +31,19 @@ use web_time::Instant;
 /// from the split faces), so such a jump means a broken split, not a worse fit.
 const REFINE_WORSE_FACTOR: f64 = 2.0;
 
-/// Below this share of the option's weight the fairness is switched off altogether.
+/// A refinement that adds less than this share of the control points (or a budget with less
+/// room than that) no longer changes a fit's course: it does not restart the stall window.
+const MIN_GROWTH: f64 = 0.01;
+
+/// Below this share of the option's weight a control point's fairness is switched off.
 const FAIRNESS_FLOOR: f64 = 1e-6;
+
+/// The most a control point's fairness grows to, in multiples of the option's weight.
+const FAIRNESS_CAP: f64 = 16.0;
+
+/// A control point whose weight in a straying sample's stencil is below this does not shape
+/// the surface there enough to be held for it.
+const STRAY_STENCIL_WEIGHT: f64 = 0.01;
 
 /// A data point's foot point on the limit surface.
 type FootPoint = Nearest<SurfaceParam>;
@@ -88,11 +100,22 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// `options.newton` with its step tolerance in model units.
     newton: NewtonOptions,
     since_refine: usize,
+    /// Iterations since a refinement last added [`MIN_GROWTH`] of the control points: the
+    /// stall window (a few points added near the budget do not change a fit's course).
+    since_growth: usize,
     /// Whether the last refinement that was due added nothing (the budget left is smaller
     /// than any split, or nothing was worth splitting).
     refine_exhausted: bool,
-    /// The fairness weight of the next move (see [`SubdivFitter::adapt_fairness`]).
-    fairness: f64,
+    /// The fairness weight of every control point's umbrella in the next move, relative to
+    /// the median data support (see [`SubdivFitter::adapt_fairness`]).
+    fairness: Vec<f64>,
+    /// The part of [`SubdivFitter::fairness`] that holds every control point.
+    global_fairness: f64,
+    /// The part of [`SubdivFitter::fairness`] that holds the surface where it strays.
+    local_fairness: Vec<f64>,
+    /// The surface samples of the last [`SubdivFitter::measure_back`] that keep the fit from
+    /// converging: farther from the data than [`BACK_TOLERANCE_FACTOR`] E_max tolerances.
+    strays: Vec<SurfaceParam>,
     accel: Accelerator,
     index: SurfaceIndex,
     scratch: Vec<(u32, f64)>,
@@ -139,8 +162,12 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .with_step_tol(options.newton.step_tol * diagonal),
             options,
             since_refine: 0,
+            since_growth: 0,
             refine_exhausted: false,
-            fairness: 0.0,
+            fairness: Vec::new(),
+            global_fairness: 0.0,
+            local_fairness: Vec::new(),
+            strays: Vec::new(),
             accel: Accelerator::new(options.acceleration),
             index,
             scratch: Vec::new(),
@@ -296,11 +323,14 @@ impl<S: ControlSurface> SubdivFitter<S> {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
                 let normals: Vec<Vec3> = self.feet.iter().map(|f| f.direction).collect();
-                let fairness =
-                    (self.fairness > 0.0).then(|| Fairness::of(&self.surface.control_polygons()));
+                let fairness = self
+                    .fairness
+                    .iter()
+                    .any(|&w| w > 0.0)
+                    .then(|| Fairness::of(&self.surface.control_polygons()));
                 let fair = fairness
                     .as_ref()
-                    .map(|f| (f, old_points.as_slice(), self.fairness));
+                    .map(|f| (f, old_points.as_slice(), self.fairness.as_slice()));
                 stencils.cg(
                     &self.error_vectors(),
                     &normals,
@@ -513,11 +543,25 @@ impl<S: ControlSurface> SubdivFitter<S> {
             PatchDomain::Triangle => 1.0 / 3.0,
             PatchDomain::Square => 0.5,
         };
-        let samples: Vec<Point3> = (0..self.surface.num_patches() as u32)
-            .flat_map(|patch| [(centre, centre), (0.0, 0.0)].map(|(u, v)| (patch, u, v)))
-            .map(|(patch, u, v)| self.surface.eval(SurfaceParam { patch, u, v }).point)
+        let params: Vec<SurfaceParam> = (0..self.surface.num_patches() as u32)
+            .flat_map(|patch| {
+                [(centre, centre), (0.0, 0.0)].map(|(u, v)| SurfaceParam { patch, u, v })
+            })
             .collect();
-        self.state.measure_back(&samples);
+        let samples: Vec<Point3> = params
+            .iter()
+            .map(|&at| self.surface.eval(at).point)
+            .collect();
+        let distances = self.state.measure_back(&samples);
+        let tol = self.state.tolerances().max_pct.map_or(f64::INFINITY, |t| {
+            BACK_TOLERANCE_FACTOR * t / 100.0 * self.state.diagonal()
+        });
+        self.strays = params
+            .into_iter()
+            .zip(distances)
+            .filter(|(_, d)| d.is_some_and(|d| d > tol))
+            .map(|(at, _)| at)
+            .collect();
     }
 
     /// Measures the surface → data distance against `reference` (the data's triangles).
@@ -529,32 +573,72 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
     /// Fairness holds the control points few data points pull on, but it also pulls the
     /// surface off the data it could reach (a fit of the fitter's own limit surface would never
-    /// end exactly). So it is a means to the surface → data bound, not a prior: while E_back is
-    /// within the E_max tolerance (or is not measured) the weight halves every iteration, and
-    /// once E_back exceeds it the weight is back to the option's.
+    /// end exactly). So it is a means to the surface → data bound, not a prior, in two parts:
+    /// - everywhere, the option's weight while any sample of the surface is farther from the
+    ///   data than the E_max tolerance (it holds, too, the control points over holes, where
+    ///   E_back is not measured), halving every iteration once none is;
+    /// - on top of it, at the control points under a sample that keeps the fit from converging
+    ///   ([`SubdivFitter::strays`]), a weight that starts at
+    ///   the option's and doubles every iteration the surface there keeps straying (up to
+    ///   [`FAIRNESS_CAP`] times), halving once it is back.
+    ///
+    /// A weight below [`FAIRNESS_FLOOR`] of the option's is 0.
     fn adapt_fairness(&mut self) {
+        let base = self.options.fairness;
+        let decay = |w: f64| {
+            if w > base * FAIRNESS_FLOOR {
+                w * 0.5
+            } else {
+                0.0
+            }
+        };
         let strays = match (self.state.back(), self.state.tolerances().max_pct) {
             (Some(b), Some(tol)) => b.max_pct > tol,
             _ => false,
         };
-        self.fairness = if strays {
-            self.options.fairness
-        } else if self.fairness > self.options.fairness * FAIRNESS_FLOOR {
-            self.fairness * 0.5
+        self.global_fairness = if strays {
+            base
         } else {
-            0.0
+            decay(self.global_fairness)
         };
+        let n = self.num_control_points();
+        self.local_fairness.resize(n, 0.0);
+        let mut straying = vec![false; n];
+        for &at in &self.strays {
+            self.scratch.clear();
+            self.surface.stencil(at, &mut self.scratch);
+            for &(j, w) in &self.scratch {
+                if w > STRAY_STENCIL_WEIGHT {
+                    if let Some(s) = straying.get_mut(j as usize) {
+                        *s = true;
+                    }
+                }
+            }
+        }
+        for (w, strays) in self.local_fairness.iter_mut().zip(straying) {
+            *w = if strays {
+                (*w * 2.0).clamp(base, base * FAIRNESS_CAP)
+            } else {
+                decay(*w)
+            };
+        }
+        self.fairness = self
+            .local_fairness
+            .iter()
+            .map(|w| w + self.global_fairness)
+            .collect();
     }
 
     /// Whether the fit cannot refine any more and its errors stopped falling (see
     /// [`stalled`]).
     fn is_stalled(&self) -> bool {
+        let n = self.num_control_points();
         let can_refine = self.options.refine
-            && self.num_control_points() < self.budget()
+            && self.budget().saturating_sub(n) as f64 >= n as f64 * MIN_GROWTH
             && !self.refine_exhausted;
         let history = self.state.log().history();
         !can_refine
-            && self.since_refine >= STALL_WINDOW
+            && self.since_growth >= STALL_WINDOW
             && stalled(
                 history,
                 &self.state.tolerances(),
@@ -584,6 +668,8 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         self.measure_back();
         self.adapt_fairness();
         self.since_refine += 1;
+        self.since_growth += 1;
+        let before_count = self.num_control_points();
         let improvement = if before > 0.0 && moved {
             (before - self.state.stats().e_rms) / before
         } else {
@@ -595,6 +681,9 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
             self.refine_exhausted = !refined;
             if refined {
                 self.since_refine = 0;
+                if self.num_control_points() as f64 >= before_count as f64 * (1.0 + MIN_GROWTH) {
+                    self.since_growth = 0;
+                }
                 self.measure_back();
             }
         }
