@@ -11,7 +11,6 @@ use common::{sphere_mesh, Rng};
 use geofit::geom::Point3;
 use geofit::mesh::{repair, repair_with, ControlMesh, PolyMesh, RepairOptions, Repaired};
 use proptest::prelude::*;
-use std::path::PathBuf;
 
 /// Repairs `mesh` and checks what every repair must give: a valid control mesh, the input's
 /// vertices first and unmoved, copies that sit on the vertex they came from.
@@ -306,33 +305,9 @@ fn quads_and_ngons_are_kept() {
     assert_eq!(out.mesh, soup);
 }
 
-/// The shared data and corpus directories, or `None` (with a message) where they are absent.
-fn shared_meshes() -> Option<Vec<PathBuf>> {
-    let data = common::data_dir();
-    if !data.is_dir() {
-        eprintln!("skipped: no shared data at {}", data.display());
-        return None;
-    }
-    let mut files = Vec::new();
-    for dir in [data.clone(), data.join("corpus")] {
-        let Ok(entries) = std::fs::read_dir(&dir) else {
-            continue;
-        };
-        for e in entries.flatten() {
-            let p = e.path();
-            let ext = p.extension().and_then(|x| x.to_str()).unwrap_or("");
-            if ["obj", "ply", "stl"].contains(&ext) {
-                files.push(p);
-            }
-        }
-    }
-    files.sort();
-    Some(files)
-}
-
 #[test]
 fn every_shared_mesh_comes_out_valid() {
-    let Some(files) = shared_meshes() else {
+    let Some(files) = common::shared_meshes() else {
         return;
     };
     for path in files {

@@ -4,7 +4,10 @@
 mod common;
 
 use common::meshes::{cube, jitter, quad_grid};
-use common::surface_checks::{assert_c1_across_edges, close, normal};
+use common::surface_checks::{
+    assert_c1_across_edges, assert_corners_are_limit_points, assert_edge_curve_is_cubic_bspline,
+    assert_same_limit_point, bspline, close, eval_checking_first_derivatives, normal,
+};
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
 use geofit::subdiv::{
@@ -57,21 +60,12 @@ fn check_refinement_invariance(mesh: &PolyMesh) {
         for c in 0..4 {
             for &(u, v) in &samples {
                 let (pu, pv) = to_parent(c, u, v);
-                let a = s0.eval(SurfaceParam {
-                    patch: f,
-                    u: pu,
-                    v: pv,
-                });
-                let b = s1.eval(SurfaceParam {
-                    patch: 4 * f + c as u32,
-                    u,
-                    v,
-                });
-                assert!(
-                    close(a.point, b.point, 1e-10),
-                    "patch {f} child {c} ({u},{v}): {:?} vs {:?}",
-                    a.point,
-                    b.point
+                let (a, b) = assert_same_limit_point(
+                    &s0,
+                    (f, pu, pv),
+                    &s1,
+                    (4 * f + c as u32, u, v),
+                    format_args!("patch {f} child {c} ({u},{v})"),
                 );
                 if u > 0.0 && v > 0.0 {
                     assert!(
@@ -110,33 +104,12 @@ fn limit_at_control_vertices_equals_limit_masks() {
         jitter(&quad_grid(3, |x, y| x * y * 0.1), 0.1, 4),
     ] {
         let s = surface(&mesh);
-        let limits = s.limit_positions();
-        for f in 0..mesh.num_faces() {
-            for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
-                .iter()
-                .enumerate()
-            {
-                let e = s.eval(SurfaceParam {
-                    patch: f as u32,
-                    u,
-                    v,
-                });
-                assert!(
-                    close(e.point, limits[mesh.face(f)[k] as usize], 1e-12),
-                    "face {f} corner {k}"
-                );
-            }
-        }
+        assert_corners_are_limit_points(
+            &s,
+            &mesh,
+            &[(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)],
+        );
     }
-}
-
-fn bspline(t: f64) -> [f64; 4] {
-    [
-        (1.0 - t).powi(3) / 6.0,
-        (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
-        (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
-        t.powi(3) / 6.0,
-    ]
 }
 
 /// Interior patches of a quad grid are uniform bicubic B-spline patches.
@@ -169,24 +142,7 @@ fn open_boundary_limit_curve_is_the_cubic_bspline_of_the_boundary() {
     let n = 5;
     let mesh = quad_grid(n, |x, y| 0.1 * x * x - 0.05 * y);
     let s = surface(&mesh);
-    let p = |i: usize| mesh.positions()[i];
-    for i in 1..n - 1 {
-        for k in 0..=8 {
-            let t = k as f64 / 8.0;
-            let e = s.eval(SurfaceParam {
-                patch: i as u32,
-                u: t,
-                v: 0.0,
-            });
-            let b = bspline(t);
-            let c: Point3 = (0..4).map(|j| p(i + j - 1) * b[j]).sum();
-            assert!(
-                close(e.point, c, 1e-12),
-                "segment {i} t {t}: {:?} vs {c:?}",
-                e.point
-            );
-        }
-    }
+    assert_edge_curve_is_cubic_bspline(&s, &mesh.positions()[..=n], 8, |i| i as u32, 1e-12);
 }
 
 #[test]
@@ -202,18 +158,14 @@ fn derivatives_match_finite_differences() {
     let h = 1e-6;
     for f in 0..6u32 {
         for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.9), (0.5, 0.5)] {
-            let e = s.eval(SurfaceParam { patch: f, u, v });
-            let at = |u: f64, v: f64| s.eval(SurfaceParam { patch: f, u, v });
-            let du = (at(u + h, v).point - at(u - h, v).point) / (2.0 * h);
-            let dv = (at(u, v + h).point - at(u, v - h).point) / (2.0 * h);
-            assert!(
-                close(du, e.du, 1e-6) && close(dv, e.dv, 1e-6),
-                "face {f} ({u},{v})"
+            let (e, d) = eval_checking_first_derivatives(
+                &s,
+                (f, u, v),
+                h,
+                format_args!("face {f} ({u},{v})"),
             );
-            let dvv = (at(u, v + h).dv - at(u, v - h).dv) / (2.0 * h);
-            let duv = (at(u, v + h).du - at(u, v - h).du) / (2.0 * h);
             assert!(
-                close(dvv, e.dvv, 1e-5) && close(duv, e.duv, 1e-5),
+                close(d.dv_v, e.dvv, 1e-5) && close(d.du_v, e.duv, 1e-5),
                 "face {f} ({u},{v}) second"
             );
         }

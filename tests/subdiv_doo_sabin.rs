@@ -6,7 +6,7 @@
 mod common;
 
 use common::meshes::{cube, icosahedron, jitter, quad_grid};
-use common::surface_checks::close;
+use common::surface_checks::{assert_same_limit_point, close, eval_checking_first_derivatives};
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
 use geofit::subdiv::{refine, DooSabinSurface, LimitSurface, Scheme, SurfaceParam};
@@ -170,21 +170,12 @@ fn check_refinement_invariance(mesh: &PolyMesh) {
             let child = sites1[&(g, p)];
             for &(u, w) in &[(0.0, 0.0), (0.5, 0.5), (0.2, 0.9), (1.0, 0.3)] {
                 let (pu, pv) = to_parent(c, u, w);
-                let a = s0.eval(SurfaceParam {
-                    patch,
-                    u: pu,
-                    v: pv,
-                });
-                let b = s1.eval(SurfaceParam {
-                    patch: child,
-                    u,
-                    v: w,
-                });
-                assert!(
-                    close(a.point, b.point, 1e-10),
-                    "patch {patch} child {c} ({u},{w}): {:?} vs {:?}",
-                    a.point,
-                    b.point
+                assert_same_limit_point(
+                    &s0,
+                    (patch, pu, pv),
+                    &s1,
+                    (child, u, w),
+                    format_args!("patch {patch} child {c} ({u},{w})"),
                 );
             }
         }
@@ -207,13 +198,11 @@ fn derivatives_match_finite_differences() {
     let h = 1e-6;
     for patch in (0..s.num_patches() as u32).step_by(7) {
         for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.9)] {
-            let e = s.eval(SurfaceParam { patch, u, v });
-            let at = |u: f64, v: f64| s.eval(SurfaceParam { patch, u, v });
-            let du = (at(u + h, v).point - at(u - h, v).point) / (2.0 * h);
-            let dv = (at(u, v + h).point - at(u, v - h).point) / (2.0 * h);
-            assert!(
-                close(du, e.du, 1e-6) && close(dv, e.dv, 1e-6),
-                "patch {patch} ({u},{v})"
+            eval_checking_first_derivatives(
+                &s,
+                (patch, u, v),
+                h,
+                format_args!("patch {patch} ({u},{v})"),
             );
         }
     }

@@ -4,7 +4,10 @@
 mod common;
 
 use common::meshes::{icosahedron, jitter, octahedron, tri_grid};
-use common::surface_checks::{assert_c1_across_edges, close};
+use common::surface_checks::{
+    assert_c1_across_edges, assert_corners_are_limit_points, assert_edge_curve_is_cubic_bspline,
+    assert_same_limit_point, close, eval_checking_first_derivatives,
+};
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
 use geofit::subdiv::{refine, refine_levels, LimitSurface, LoopSurface, Scheme, SurfaceParam};
@@ -57,21 +60,12 @@ fn check_refinement_invariance(mesh: &PolyMesh) {
         for c in 0..4 {
             for &(u, v) in &samples() {
                 let (pu, pv, scale) = to_parent(c, u, v);
-                let a = s0.eval(SurfaceParam {
-                    patch: f,
-                    u: pu,
-                    v: pv,
-                });
-                let b = s1.eval(SurfaceParam {
-                    patch: 4 * f + c as u32,
-                    u,
-                    v,
-                });
-                assert!(
-                    close(a.point, b.point, 1e-10),
-                    "patch {f} child {c} ({u},{v}): {:?} vs {:?}",
-                    a.point,
-                    b.point
+                let (a, b) = assert_same_limit_point(
+                    &s0,
+                    (f, pu, pv),
+                    &s1,
+                    (4 * f + c as u32, u, v),
+                    format_args!("patch {f} child {c} ({u},{v})"),
                 );
                 // Near extraordinary vertices derivatives of the two parameterisations differ
                 // only by the chain rule.
@@ -124,18 +118,7 @@ fn limit_at_control_vertices_equals_limit_masks() {
         jitter(&tri_grid(4, |x, y| x * y * 0.1), 0.1, 5),
     ] {
         let s = loop_surface(&mesh);
-        let limits = s.limit_positions();
-        for f in 0..mesh.num_faces() {
-            for (k, &(u, v)) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)].iter().enumerate() {
-                let e = s.eval(SurfaceParam {
-                    patch: f as u32,
-                    u,
-                    v,
-                });
-                let vtx = mesh.face(f)[k] as usize;
-                assert!(close(e.point, limits[vtx], 1e-12), "face {f} corner {k}");
-            }
-        }
+        assert_corners_are_limit_points(&s, &mesh, &[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]);
     }
 }
 
@@ -184,15 +167,6 @@ fn regular_and_boundary_patches_match_refined_limit_points() {
     }
 }
 
-fn bspline(t: f64) -> [f64; 4] {
-    [
-        (1.0 - t).powi(3) / 6.0,
-        (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
-        (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
-        t.powi(3) / 6.0,
-    ]
-}
-
 /// A crease tagged along a grid line is the cubic B-spline curve of its vertices, and the
 /// surface stays exact (refinement keeps the limit) on both sides.
 #[test]
@@ -209,36 +183,22 @@ fn crease_limit_curve_is_the_cubic_bspline_of_the_crease() {
         cm.set_sharp(id(i, 3), id(i + 1, 3), true).unwrap();
     }
     let s = LoopSurface::from_control_mesh(cm.clone()).unwrap();
-    let p = |i: usize| mesh.positions()[id(i, 3) as usize];
-    for i in 1..n - 1 {
-        // Face 2 (3 n + i) has edge 0 from (i, 3) to (i + 1, 3).
-        for k in 0..=4 {
-            let t = k as f64 / 4.0;
-            let e = s.eval(SurfaceParam {
-                patch: (2 * (3 * n + i)) as u32,
-                u: t,
-                v: 0.0,
-            });
-            let b = bspline(t);
-            let c: Point3 = (0..4).map(|j| p(i + j - 1) * b[j]).sum();
-            assert!(close(e.point, c, 1e-10), "segment {i} t {t}");
-        }
-    }
+    let crease: Vec<Point3> = (0..=n)
+        .map(|i| mesh.positions()[id(i, 3) as usize])
+        .collect();
+    // Face 2 (3 n + i) has edge 0 from (i, 3) to (i + 1, 3).
+    assert_edge_curve_is_cubic_bspline(&s, &crease, 4, |i| (2 * (3 * n + i)) as u32, 1e-10);
     let s1 = LoopSurface::from_control_mesh(refine(Scheme::Loop, &cm).unwrap()).unwrap();
     for f in 0..s.num_patches() as u32 {
         for c in 0..4 {
             let (pu, pv, _) = to_parent(c, 0.3, 0.2);
-            let a = s.eval(SurfaceParam {
-                patch: f,
-                u: pu,
-                v: pv,
-            });
-            let b = s1.eval(SurfaceParam {
-                patch: 4 * f + c as u32,
-                u: 0.3,
-                v: 0.2,
-            });
-            assert!(close(a.point, b.point, 1e-10), "face {f} child {c}");
+            assert_same_limit_point(
+                &s,
+                (f, pu, pv),
+                &s1,
+                (4 * f + c as u32, 0.3, 0.2),
+                format_args!("face {f} child {c}"),
+            );
         }
     }
 }
@@ -284,30 +244,8 @@ fn open_boundary_limit_curve_is_the_cubic_bspline_of_the_boundary() {
     let n = 6;
     let mesh = tri_grid(n, |x, y| 0.1 * x * x - 0.05 * y);
     let s = loop_surface(&mesh);
-    let p = |i: usize| mesh.positions()[i];
     // Bottom row faces 2 * i have edge 0 from vertex i to i + 1 on the boundary.
-    for i in 1..n - 1 {
-        for k in 0..=8 {
-            let t = k as f64 / 8.0;
-            let e = s.eval(SurfaceParam {
-                patch: 2 * i as u32,
-                u: t,
-                v: 0.0,
-            });
-            let b = [
-                (1.0 - t).powi(3) / 6.0,
-                (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
-                (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
-                t.powi(3) / 6.0,
-            ];
-            let c: Point3 = (0..4).map(|j| p(i + j - 1) * b[j]).sum();
-            assert!(
-                close(e.point, c, 1e-9),
-                "segment {i} t {t}: {:?} vs {c:?}",
-                e.point
-            );
-        }
-    }
+    assert_edge_curve_is_cubic_bspline(&s, &mesh.positions()[..=n], 8, |i| 2 * i as u32, 1e-9);
 }
 
 #[test]
@@ -317,18 +255,14 @@ fn derivatives_match_finite_differences() {
     let h = 1e-6;
     for f in 0..mesh.num_faces() as u32 {
         for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.2), (0.3, 0.6)] {
-            let e = s.eval(SurfaceParam { patch: f, u, v });
-            let at = |u: f64, v: f64| s.eval(SurfaceParam { patch: f, u, v });
-            let du = (at(u + h, v).point - at(u - h, v).point) / (2.0 * h);
-            let dv = (at(u, v + h).point - at(u, v - h).point) / (2.0 * h);
-            assert!(
-                close(du, e.du, 1e-6) && close(dv, e.dv, 1e-6),
-                "face {f} ({u},{v})"
+            let (e, d) = eval_checking_first_derivatives(
+                &s,
+                (f, u, v),
+                h,
+                format_args!("face {f} ({u},{v})"),
             );
-            let duu = (at(u + h, v).du - at(u - h, v).du) / (2.0 * h);
-            let duv = (at(u, v + h).du - at(u, v - h).du) / (2.0 * h);
             assert!(
-                close(duu, e.duu, 1e-5) && close(duv, e.duv, 1e-5),
+                close(d.du_u, e.duu, 1e-5) && close(d.du_v, e.duv, 1e-5),
                 "face {f} ({u},{v}) second"
             );
         }

@@ -1,7 +1,8 @@
 //! Checks shared by the subdivision tests: tolerant comparison, unit normals, and C1 continuity
 //! across every interior patch edge.
 
-use geofit::geom::Vec3;
+use geofit::geom::{Point3, Vec3};
+use geofit::mesh::PolyMesh;
 use geofit::subdiv::{LimitEval, LimitSurface, PatchDomain, SubdivSurface, SurfaceParam};
 
 /// `a` and `b` agree to `tol`, relative to their size (absolute near the origin).
@@ -64,4 +65,119 @@ pub fn assert_c1_across_edges(s: &SubdivSurface, samples: usize) {
             }
         }
     }
+}
+
+/// The four uniform cubic B-spline basis functions at `t` in [0, 1].
+pub fn bspline(t: f64) -> [f64; 4] {
+    [
+        (1.0 - t).powi(3) / 6.0,
+        (3.0 * t.powi(3) - 6.0 * t * t + 4.0) / 6.0,
+        (-3.0 * t.powi(3) + 3.0 * t * t + 3.0 * t + 1.0) / 6.0,
+        t.powi(3) / 6.0,
+    ]
+}
+
+/// Evaluates `coarse` at `(patch, u, v)` and `fine` at `(child, u, v)`, asserts that the two
+/// points agree to 1e-10 (`what` names the place in the message), and returns both evaluations.
+pub fn assert_same_limit_point(
+    coarse: &SubdivSurface,
+    (patch, pu, pv): (u32, f64, f64),
+    fine: &SubdivSurface,
+    (child, u, v): (u32, f64, f64),
+    what: std::fmt::Arguments,
+) -> (LimitEval, LimitEval) {
+    let a = coarse.eval(SurfaceParam {
+        patch,
+        u: pu,
+        v: pv,
+    });
+    let b = fine.eval(SurfaceParam { patch: child, u, v });
+    assert!(
+        close(a.point, b.point, 1e-10),
+        "{what}: {:?} vs {:?}",
+        a.point,
+        b.point
+    );
+    (a, b)
+}
+
+/// For each face of `mesh` (the control mesh of `s`), the limit point at the parameters
+/// `corners[k]` is the limit position of the face's vertex k, to 1e-12.
+pub fn assert_corners_are_limit_points(s: &SubdivSurface, mesh: &PolyMesh, corners: &[(f64, f64)]) {
+    let limits = s.limit_positions();
+    for f in 0..mesh.num_faces() {
+        for (k, &(u, v)) in corners.iter().enumerate() {
+            let e = s.eval(SurfaceParam {
+                patch: f as u32,
+                u,
+                v,
+            });
+            assert!(
+                close(e.point, limits[mesh.face(f)[k] as usize], 1e-12),
+                "face {f} corner {k}"
+            );
+        }
+    }
+}
+
+/// The limit curve along edge 0 of the patches `patch(i)` is the uniform cubic B-spline of the
+/// polyline `row`: checked for the segments i in 1..row.len() - 2 at `steps + 1` parameters
+/// each, to `tol`.
+pub fn assert_edge_curve_is_cubic_bspline(
+    s: &SubdivSurface,
+    row: &[Point3],
+    steps: usize,
+    patch: impl Fn(usize) -> u32,
+    tol: f64,
+) {
+    for i in 1..row.len() - 2 {
+        for k in 0..=steps {
+            let t = k as f64 / steps as f64;
+            let e = s.eval(SurfaceParam {
+                patch: patch(i),
+                u: t,
+                v: 0.0,
+            });
+            let b = bspline(t);
+            let c: Point3 = (0..4).map(|j| row[i + j - 1] * b[j]).sum();
+            assert!(
+                close(e.point, c, tol),
+                "segment {i} t {t}: {:?} vs {c:?}",
+                e.point
+            );
+        }
+    }
+}
+
+/// Central differences with step `h` of an evaluation: ∂/∂u and ∂/∂v of S, S_u and S_v.
+pub struct CentralDifferences {
+    pub point_u: Vec3,
+    pub point_v: Vec3,
+    pub du_u: Vec3,
+    pub du_v: Vec3,
+    pub dv_v: Vec3,
+}
+
+/// The evaluation of `s` at `(patch, u, v)`, with its first derivatives checked against central
+/// differences of step `h` (to 1e-6; `what` names the place), and those differences.
+pub fn eval_checking_first_derivatives(
+    s: &SubdivSurface,
+    (patch, u, v): (u32, f64, f64),
+    h: f64,
+    what: std::fmt::Arguments,
+) -> (LimitEval, CentralDifferences) {
+    let e = s.eval(SurfaceParam { patch, u, v });
+    let at = |u: f64, v: f64| s.eval(SurfaceParam { patch, u, v });
+    let d = CentralDifferences {
+        point_u: (at(u + h, v).point - at(u - h, v).point) / (2.0 * h),
+        point_v: (at(u, v + h).point - at(u, v - h).point) / (2.0 * h),
+        du_u: (at(u + h, v).du - at(u - h, v).du) / (2.0 * h),
+        du_v: (at(u, v + h).du - at(u, v - h).du) / (2.0 * h),
+        dv_v: (at(u, v + h).dv - at(u, v - h).dv) / (2.0 * h),
+    };
+    assert!(
+        close(d.point_u, e.du, 1e-6) && close(d.point_v, e.dv, 1e-6),
+        "{what}"
+    );
+    (e, d)
 }
