@@ -4,7 +4,7 @@
 mod common;
 
 use common::linear::{sample, Linear};
-use common::{bump_grid, perturbed_z, sphere_mesh, Rng};
+use common::{bump_grid, bumpy_sphere, perturbed_z, sphere_mesh, Rng};
 use geofit::fit::{
     Acceleration, FitStatus, Fitter, SubdivFitOptions, SubdivFitter, Tolerances, Weighting,
 };
@@ -112,13 +112,7 @@ fn foot_points_are_local_minima() {
 #[test]
 fn damping_keeps_rms_from_growing() {
     let control = sphere_mesh(1);
-    let mut rng = Rng(11);
-    let data: Vec<Point3> = (0..2000)
-        .map(|_| {
-            let d = rng.vec().normalize();
-            d * (1.0 + 0.2 * (3.0 * d.x).sin() * d.y)
-        })
-        .collect();
+    let data = bumpy_sphere(11, 2000, |d| 0.2 * (3.0 * d.x).sin() * d.y);
     for accel in [
         Acceleration::None,
         Acceleration::Relax { omega: 1.9 },
@@ -146,13 +140,7 @@ fn damping_keeps_rms_from_growing() {
 #[test]
 fn refinement_stays_manifold_conforming_and_within_budget() {
     let control = sphere_mesh(1);
-    let mut rng = Rng(5);
-    let data: Vec<Point3> = (0..3000)
-        .map(|_| {
-            let d = rng.vec().normalize();
-            d * (1.0 + 0.3 * (4.0 * d.x).sin() * (3.0 * d.z).cos())
-        })
-        .collect();
+    let data = bumpy_sphere(5, 3000, |d| 0.3 * (4.0 * d.x).sin() * (3.0 * d.z).cos());
     let options = SubdivFitOptions::default()
         .with_max_iter(40)
         .with_max_control(Some(400))

@@ -3,7 +3,7 @@
 mod common;
 
 use common::linear::sample;
-use common::{perturbed, sphere_mesh, Rng};
+use common::{bumpy_sphere, perturbed, sphere_mesh, Rng};
 use geofit::fit::{surface_of, Fitter, SubdivFitOptions, SubdivFitter};
 use geofit::geom::Point3;
 use geofit::subdiv::{LimitSurface, Scheme, SubdivSurface};
@@ -53,13 +53,7 @@ fn loop_foot_points_are_orthogonal_and_weights_sum_to_one() {
 
 #[test]
 fn loop_refinement_with_flips_stays_manifold_and_finite() {
-    let mut rng = Rng(21);
-    let data: Vec<Point3> = (0..3000)
-        .map(|_| {
-            let d = rng.vec().normalize();
-            d * (1.0 + 0.25 * (5.0 * d.x).sin() * (4.0 * d.y).cos())
-        })
-        .collect();
+    let data = bumpy_sphere(21, 3000, |d| 0.25 * (5.0 * d.x).sin() * (4.0 * d.y).cos());
     let options = SubdivFitOptions::default()
         .with_max_iter(15)
         .with_max_control(Some(300))

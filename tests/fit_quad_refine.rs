@@ -5,7 +5,7 @@
 mod common;
 
 use common::meshes::{cube, quad_grid};
-use common::{sphere_mesh, Rng};
+use common::{bumpy_sphere, sphere_mesh, Rng};
 use geofit::fit::{surface_of, Fitter, SubdivFitOptions, SubdivFitter, Tolerances};
 use geofit::geom::Point3;
 use geofit::mesh::check_oriented_edges;
@@ -182,13 +182,7 @@ fn limit_surface_is_unchanged_away_from_the_split_and_close_near_it() {
 
 /// Data on a bumpy sphere, fitted from the quad sphere with and without refinement.
 fn bumpy_fit(refine: bool) -> SubdivFitter<SubdivSurface> {
-    let mut rng = Rng(31);
-    let data: Vec<Point3> = (0..4000)
-        .map(|_| {
-            let d = rng.vec().normalize();
-            d * (1.0 + 0.2 * (6.0 * d.x).sin() * (5.0 * d.y).cos())
-        })
-        .collect();
+    let data = bumpy_sphere(31, 4000, |d| 0.2 * (6.0 * d.x).sin() * (5.0 * d.y).cos());
     let options = SubdivFitOptions::default()
         .with_tolerances(Tolerances {
             avg_pct: None,

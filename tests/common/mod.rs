@@ -71,6 +71,18 @@ pub fn sphere_mesh(levels: usize) -> PolyMesh {
     PolyMesh::try_new(pts, tris).expect("valid sphere")
 }
 
+/// `n` points d · (1 + bump(d)) over directions d (`Rng(seed)` in the cube, normalised): a bumpy
+/// sphere.
+pub fn bumpy_sphere(seed: u64, n: usize, bump: impl Fn(Point3) -> f64) -> Vec<Point3> {
+    let mut rng = Rng(seed);
+    (0..n)
+        .map(|_| {
+            let d = rng.vec().normalize();
+            d * (1.0 + bump(d))
+        })
+        .collect()
+}
+
 /// An open n × n grid of triangles over [0, 1]² with a bump of `height`: a surface with a
 /// boundary.
 pub fn bump_grid(n: usize, height: f64) -> PolyMesh {
