@@ -1,6 +1,8 @@
 //! Geometric (error-vector) B-spline surface fitting: the error falls, knots are inserted where
 //! it stays high, and bad options are typed errors.
 
+mod common;
+
 use geofit::fit::{
     Acceleration, FitError, FitStatus, Fitter, GeometricSurfaceFitter, GeometricSurfaceOptions,
     LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, TolMode,
@@ -148,46 +150,29 @@ fn cli_fit_scheme_bspline_writes_the_report() {
     let report = dir.join("r.json");
     let step = dir.join("s.stp");
     for method in ["least-squares", "geometric"] {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
-            .args([
-                "fit",
-                data.to_str().unwrap(),
-                "--scheme",
-                "bspline",
-                "--ctrl-u",
-                "6",
-            ])
-            .args([
-                "--ctrl-v",
-                "7",
-                "--method",
-                method,
-                "--json",
-                report.to_str().unwrap(),
-            ])
-            .args(["--step", step.to_str().unwrap()])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let r: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+        common::geofit_ok(&[
+            "fit",
+            data.to_str().unwrap(),
+            "--scheme",
+            "bspline",
+            "--ctrl-u",
+            "6",
+            "--ctrl-v",
+            "7",
+            "--method",
+            method,
+            "--json",
+            report.to_str().unwrap(),
+            "--step",
+            step.to_str().unwrap(),
+        ]);
+        let r = common::read_json(&report);
         assert_eq!(r["scheme"], "bspline-surface");
         assert_eq!(r["points"], 900);
         assert_eq!(r["control_points_u"], 6);
         assert_eq!(r["control_points_v"], 7);
         assert_eq!(r["final_control_points"], 42);
-        for key in [
-            "e_avg_pct",
-            "e_max_pct",
-            "e_rms_pct",
-            "precompute_s",
-            "fit_s",
-            "total_s",
-        ] {
+        for key in common::REPORT_NUMBERS {
             assert!(r[key].as_f64().is_some_and(f64::is_finite), "{key}");
         }
         assert!(!r["history"].as_array().unwrap().is_empty());
@@ -195,17 +180,14 @@ fn cli_fit_scheme_bspline_writes_the_report() {
             .unwrap()
             .contains("B_SPLINE_SURFACE_WITH_KNOTS"));
     }
-    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
-        .args([
-            "fit",
-            data.to_str().unwrap(),
-            "--scheme",
-            "bspline",
-            "--ctrl",
-            "50",
-        ])
-        .output()
-        .unwrap();
+    let bad = common::geofit(&[
+        "fit",
+        data.to_str().unwrap(),
+        "--scheme",
+        "bspline",
+        "--ctrl",
+        "50",
+    ]);
     assert!(!bad.status.success());
     assert!(String::from_utf8_lossy(&bad.stderr).contains("not a square"));
     // Options of one branch given to the other are errors, not silently ignored.

@@ -4,12 +4,11 @@
 
 mod common;
 
-use common::Rng;
+use common::{geofit, geofit_ok, read_json, Rng};
 use geofit::fit::{FitData, FitError, FitReport, FitSpec, FitStatus, Scheme};
 use geofit::geom::Point3;
 use geofit::mesh::PolyMesh;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// `n` points spread evenly (Fibonacci spiral) over an ellipsoid with half-axes 1, 0.8, 0.6.
 fn ellipsoid(n: usize) -> Vec<Point3> {
@@ -128,13 +127,6 @@ fn a_control_mesh_for_points_needs_no_reconstruction_only_when_given() {
 
 // ---- through `geofit fit` ----
 
-fn geofit(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_geofit"))
-        .args(args)
-        .output()
-        .expect("the geofit binary runs")
-}
-
 /// A fresh temporary directory for one test.
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("geofit-fit-cloud-{name}-{}", std::process::id()));
@@ -151,7 +143,7 @@ fn geofit_fit_reconstructs_a_closed_xyz_cloud_and_reports_it() {
     let dir = temp_dir("closed");
     let (file, json) = (dir.join("ellipsoid.xyz"), dir.join("r.json"));
     write_xyz(&file, &ellipsoid(1_500));
-    let out = geofit(&[
+    let stdout = geofit_ok(&[
         "fit",
         file.to_str().expect("utf-8"),
         "--cloud",
@@ -167,15 +159,8 @@ fn geofit_fit_reconstructs_a_closed_xyz_cloud_and_reports_it() {
         "--json",
         json.to_str().expect("utf-8"),
     ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(stdout.contains("reconstructed closed surface"), "{stdout}");
-    let report: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).expect("report")).expect("JSON");
+    let report = read_json(&json);
     assert_eq!(report["points"], 1_500);
     assert_eq!(report["converged"], true, "{report}");
     assert!(report["e_max_pct"].as_f64().expect("number") <= 0.3);
@@ -216,13 +201,7 @@ fn geofit_fit_on_degenerate_clouds_fails_clearly_or_fits_a_sheet() {
         .collect();
     let path = dir.join("flat.xyz");
     write_xyz(&path, &flat);
-    let out = geofit(&["fit", path.to_str().expect("utf-8"), "--quiet"]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = geofit_ok(&["fit", path.to_str().expect("utf-8"), "--quiet"]);
     assert!(stdout.contains("converged"), "{stdout}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -10,7 +10,7 @@ pub mod surface_checks;
 
 use geofit::geom::Point3;
 use geofit::mesh::PolyMesh;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `$GEOFIT_DATA`, else `<repo>/../shared/data`, else `/work/shared/data`.
 pub fn data_dir() -> PathBuf {
@@ -193,3 +193,39 @@ pub fn run_ok(command: &mut std::process::Command) -> std::process::Output {
     );
     out
 }
+
+/// Runs the geofit binary with `args`.
+pub fn geofit(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
+        .args(args)
+        .output()
+        .expect("the geofit binary runs")
+}
+
+/// Runs the geofit binary with `args`, failing the test with its stdout and stderr when it
+/// fails; returns its stdout.
+pub fn geofit_ok(args: &[&str]) -> String {
+    let out = geofit(args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// A JSON file (such as the report of `geofit fit --json`), parsed.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).expect("report")).expect("JSON")
+}
+
+/// The numbers every `geofit fit` JSON report holds: the errors and the timings.
+pub const REPORT_NUMBERS: [&str; 6] = [
+    "e_avg_pct",
+    "e_max_pct",
+    "e_rms_pct",
+    "precompute_s",
+    "fit_s",
+    "total_s",
+];
