@@ -63,26 +63,18 @@ fn refines_to_an_obj_with_the_expected_counts() {
 #[test]
 fn bad_input_gives_a_message_not_a_crash() {
     let out = std::env::temp_dir().join("geofit-cli-subdiv-never.obj");
-    let o = run(&["/nonexistent/mesh.obj", "-o", out.to_str().unwrap()]);
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/mesh.obj"));
-    let o = run(&[
-        data("bunny_patch.obj").to_str().unwrap(),
-        "--levels",
-        "99",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--levels"));
-    // Loop on a quad-dominant mesh names the offending face.
-    let o = run(&[
-        data("spot_quads.obj").to_str().unwrap(),
-        "--scheme",
-        "loop",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("face"));
+    let (bunny, spot) = (data("bunny_patch.obj"), data("spot_quads.obj"));
+    for (args, needle) in [
+        (vec!["/nonexistent/mesh.obj"], "/nonexistent/mesh.obj"),
+        (vec![bunny.to_str().unwrap(), "--levels", "99"], "--levels"),
+        // Loop on a quad-dominant mesh names the offending face.
+        (vec![spot.to_str().unwrap(), "--scheme", "loop"], "face"),
+    ] {
+        let o = run(&[args.as_slice(), &["-o", out.to_str().unwrap()]].concat());
+        assert!(!o.status.success(), "{args:?}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains(needle),
+            "{args:?}"
+        );
+    }
 }

@@ -244,6 +244,20 @@ fn base64(data: &[u8]) -> String {
     s
 }
 
+/// Reading `data` fails as a truncated `format` file, at `at` where given; returns the error.
+fn assert_truncated(data: &[u8], format: Format, at: Option<Location>) -> ReadError {
+    let e = read_bytes(data, None).unwrap_err();
+    assert!(
+        matches!(
+            &e,
+            ReadError::Truncated { format: f, at: a, .. }
+                if *f == format && at.is_none_or(|at| *a == at)
+        ),
+        "{e}"
+    );
+    e
+}
+
 #[test]
 #[cfg_attr(
     not(all(feature = "e57", feature = "laz")),
@@ -253,46 +267,15 @@ fn damaged_headers_give_typed_errors_at_the_place() {
     // LAS: point count far beyond the file.
     let mut las = bytes("bunny.las");
     las[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
-    let e = read_bytes(&las, None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ReadError::Truncated {
-                format: Format::Las,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_truncated(&las, Format::Las, None);
     // LAZ: point count beyond what the compressed bytes can hold.
     let mut laz = bytes("bunny.laz");
     laz[107..111].copy_from_slice(&u32::MAX.to_le_bytes());
-    let e = read_bytes(&laz, None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ReadError::Truncated {
-                format: Format::Laz,
-                at: Location::Byte(107),
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_truncated(&laz, Format::Laz, Some(Location::Byte(107)));
     // E57: the XML section claims to be longer than the file.
     let mut e57 = bytes("bun000-grid.e57");
     e57[32..40].copy_from_slice(&(1u64 << 40).to_le_bytes());
-    let e = read_bytes(&e57, None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ReadError::Truncated {
-                format: Format::E57,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_truncated(&e57, Format::E57, None);
     // E57 with a flipped data byte fails its page checksum.
     let mut e57 = bytes("bun000-grid.e57");
     e57[2000] ^= 0x55;
@@ -300,51 +283,19 @@ fn damaged_headers_give_typed_errors_at_the_place() {
     // PTX: more cells than the bytes can hold.
     let ptx = String::from_utf8(bytes("bun000-grid.ptx")).expect("text");
     let huge = ptx.replacen("52\n40\n", "52000000\n40000000\n", 1);
-    let e = read_bytes(huge.as_bytes(), None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ReadError::Truncated {
-                format: Format::Ptx,
-                at: Location::Line(1),
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_truncated(huge.as_bytes(), Format::Ptx, Some(Location::Line(1)));
     // PCD: more points than the binary body holds.
     let pcd = bytes("bunny-binary.pcd");
     let text = String::from_utf8_lossy(&pcd);
     let at = text.find("POINTS 799").expect("POINTS line");
     let mut bad = pcd.clone();
     bad.splice(at..at + 10, b"POINTS 999".iter().copied());
-    let e = read_bytes(&bad, None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ReadError::Truncated {
-                format: Format::Pcd,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    let e = assert_truncated(&bad, Format::Pcd, None);
     assert!(e.to_string().contains("declares 999 points"), "{e}");
     // GLB: the header length beyond the file.
     let mut glb = bytes("suzanne-scene.glb");
     glb[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
-    let e = read_bytes(&glb, None).unwrap_err();
-    assert!(
-        matches!(
-            e,
-            ReadError::Truncated {
-                format: Format::Glb,
-                at: Location::Byte(8),
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_truncated(&glb, Format::Glb, Some(Location::Byte(8)));
 }
 
 #[test]
