@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::fuzz::{apply, cases, check_consistent, edit, read_checked};
+use common::fuzz::{apply, cases, edit, read_checked, read_sample};
 use geofit::geom::Point3;
 use geofit::io::{read_bytes, to_glb_bytes, GlbOptions};
 use geofit::mesh::PolyMesh;
@@ -101,8 +101,7 @@ const FORMAT_WORDS: [&[u8]; 10] = [
 #[test]
 fn samples_are_valid() {
     for (name, bytes) in samples() {
-        let f = read_bytes(&bytes, Some(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        check_consistent(&f);
+        let f = read_sample(name, &bytes);
         let g = read_bytes(&bytes, None).unwrap_or_else(|e| panic!("{name} without name: {e}"));
         assert_eq!(f.format, g.format, "{name}");
     }

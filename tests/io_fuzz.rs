@@ -4,9 +4,9 @@
 
 mod common;
 
-use common::fuzz::{apply, cases, check_consistent, edit, read_checked};
+use common::fuzz::{apply, cases, edit, read_checked, read_sample};
 use geofit::geom::Point3;
-use geofit::io::{read_bytes, to_ply_bytes};
+use geofit::io::to_ply_bytes;
 use geofit::mesh::PolyMesh;
 use proptest::prelude::*;
 
@@ -85,8 +85,7 @@ const TEXT_WORDS: [&[u8]; 12] = [
 #[test]
 fn samples_are_valid() {
     for (name, bytes) in samples() {
-        let f = read_bytes(&bytes, Some(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        check_consistent(&f);
+        read_sample(name, &bytes);
     }
 }
 

@@ -20,6 +20,13 @@ pub fn check_consistent(f: &LoadedFile) {
     assert!(f.dimension == 2 || f.dimension == 3);
 }
 
+/// Reads the valid sample `bytes` named `name`, checks it is consistent and returns it.
+pub fn read_sample(name: &str, bytes: &[u8]) -> LoadedFile {
+    let f = read_bytes(bytes, Some(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    check_consistent(&f);
+    f
+}
+
 /// Reads `bytes`: what is accepted is consistent, what is refused says why.
 pub fn read_checked(bytes: &[u8], name: Option<&str>) {
     match read_bytes(bytes, name) {
