@@ -22,29 +22,22 @@ fn assert_obj(name: &str, vertices: usize, faces: usize) {
     assert_eq!(f.dimension, 3);
 }
 
-#[test]
-fn stanford_bunny() {
-    assert_obj("stanford-bunny.obj", 35_947, 69_451);
+/// One test per OBJ scan: `test: file, vertices, faces;`.
+macro_rules! obj_tests {
+    ($($test:ident: $file:literal, $vertices:expr, $faces:expr;)*) => {$(
+        #[test]
+        fn $test() {
+            assert_obj($file, $vertices, $faces);
+        }
+    )*};
 }
 
-#[test]
-fn fandisk() {
-    assert_obj("fandisk.obj", 6_475, 12_946);
-}
-
-#[test]
-fn rocker_arm() {
-    assert_obj("rocker-arm.obj", 10_044, 20_088);
-}
-
-#[test]
-fn spot() {
-    assert_obj("spot.obj", 2_930, 5_856);
-}
-
-#[test]
-fn teapot() {
-    assert_obj("teapot.obj", 3_644, 6_320);
+obj_tests! {
+    stanford_bunny: "stanford-bunny.obj", 35_947, 69_451;
+    fandisk: "fandisk.obj", 6_475, 12_946;
+    rocker_arm: "rocker-arm.obj", 10_044, 20_088;
+    spot: "spot.obj", 2_930, 5_856;
+    teapot: "teapot.obj", 3_644, 6_320;
 }
 
 #[test]

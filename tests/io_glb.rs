@@ -31,6 +31,12 @@ fn json_of(glb: &[u8]) -> Value {
 }
 
 /// The f32 values of accessor `a` (tightly packed floats).
+/// The values of vertex attribute `name` of the first primitive.
+fn attribute(glb: &[u8], doc: &Value, name: &str) -> Vec<f32> {
+    let attributes = &doc["meshes"][0]["primitives"][0]["attributes"];
+    floats(glb, doc, attributes[name].as_u64().expect(name) as usize)
+}
+
 fn floats(glb: &[u8], doc: &Value, a: usize) -> Vec<f32> {
     let json_len = u32::from_le_bytes([glb[12], glb[13], glb[14], glb[15]]) as usize;
     let bin = &glb[20 + json_len + 8..];
@@ -96,11 +102,7 @@ fn positions_triangles_normals_and_bounds() {
             Some(f64::from(max))
         );
     }
-    let normals = floats(
-        &glb,
-        &doc,
-        prim["attributes"]["NORMAL"].as_u64().expect("NORMAL") as usize,
-    );
+    let normals = attribute(&glb, &doc, "NORMAL");
     for n in normals.chunks_exact(3) {
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         assert!((len - 1.0).abs() < 1e-6, "{len}");
@@ -130,21 +132,12 @@ fn deviation_colours_extras_and_units() {
     let doc = json_of(&glb);
     assert_eq!(doc["scenes"][0]["extras"], extras);
     assert_eq!(doc["nodes"][0]["scale"], json!([0.001, 0.001, 0.001]));
-    let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
-    let dev = floats(
-        &glb,
-        &doc,
-        attrs["_DEVIATION"].as_u64().expect("_DEVIATION") as usize,
-    );
+    let dev = attribute(&glb, &doc, "_DEVIATION");
     assert_eq!(dev.len(), deviation.len());
     for (a, b) in dev.iter().zip(&deviation) {
         assert_eq!(*a, *b as f32);
     }
-    let colours = floats(
-        &glb,
-        &doc,
-        attrs["COLOR_0"].as_u64().expect("COLOR_0") as usize,
-    );
+    let colours = attribute(&glb, &doc, "COLOR_0");
     for (c, &d) in colours.chunks_exact(3).zip(&deviation) {
         assert!(c.iter().all(|v| (0.0..=1.0).contains(v)));
         let srgb = diverging_colour(d, tol);
@@ -178,21 +171,12 @@ fn custom_colour_map_given_normals_and_points_only() {
     let glb = to_glb_bytes(&mesh, &options).expect("glb");
     save("custom-map.glb", &glb);
     let doc = json_of(&glb);
-    let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
-    let colours = floats(
-        &glb,
-        &doc,
-        attrs["COLOR_0"].as_u64().expect("COLOR_0") as usize,
-    );
+    let colours = attribute(&glb, &doc, "COLOR_0");
     assert!(
         (colours[1] - 0.214).abs() < 1e-3 && colours[2] == 1.0,
         "{colours:?}"
     );
-    let n = floats(
-        &glb,
-        &doc,
-        attrs["NORMAL"].as_u64().expect("NORMAL") as usize,
-    );
+    let n = attribute(&glb, &doc, "NORMAL");
     assert_eq!(&n[..3], &[0.0, 0.0, 1.0]);
 
     let points =
@@ -243,12 +227,7 @@ fn degenerate_triangles_and_lone_vertices_still_give_unit_normals() {
     let glb = to_glb_bytes(&mesh, &GlbOptions::default().with_deviation(&dev)).expect("glb");
     save("degenerate.glb", &glb);
     let doc = json_of(&glb);
-    let attrs = &doc["meshes"][0]["primitives"][0]["attributes"];
-    let n = floats(
-        &glb,
-        &doc,
-        attrs["NORMAL"].as_u64().expect("NORMAL") as usize,
-    );
+    let n = attribute(&glb, &doc, "NORMAL");
     assert_eq!(&n[12..15], &[0.0, 0.0, 1.0]);
     for v in n.chunks_exact(3) {
         assert!(((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt() - 1.0).abs() < 1e-6);
