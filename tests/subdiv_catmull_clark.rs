@@ -5,8 +5,9 @@ mod common;
 
 use common::meshes::{cube, jitter, quad_grid};
 use common::surface_checks::{
-    assert_c1_across_edges, assert_corners_are_limit_points, assert_edge_curve_is_cubic_bspline,
-    assert_same_limit_point, bspline, close, eval_checking_first_derivatives, normal,
+    assert_c1_across_edges, assert_corners_are_limit_points,
+    assert_derivatives_match_finite_differences, assert_edge_curve_is_cubic_bspline,
+    assert_same_limit_point, bspline, close, normal,
 };
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
@@ -155,19 +156,10 @@ fn limit_surface_is_c1_across_patch_edges() {
 #[test]
 fn derivatives_match_finite_differences() {
     let s = surface(&jitter(&cube(), 0.1, 7));
-    let h = 1e-6;
-    for f in 0..6u32 {
-        for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.9), (0.5, 0.5)] {
-            let (e, d) = eval_checking_first_derivatives(
-                &s,
-                (f, u, v),
-                h,
-                format_args!("face {f} ({u},{v})"),
-            );
-            assert!(
-                close(d.dv_v, e.dvv, 1e-5) && close(d.du_v, e.duv, 1e-5),
-                "face {f} ({u},{v}) second"
-            );
-        }
-    }
+    assert_derivatives_match_finite_differences(
+        &s,
+        0..6,
+        &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.9), (0.5, 0.5)],
+        |e, d| close(d.dv_v, e.dvv, 1e-5) && close(d.du_v, e.duv, 1e-5),
+    );
 }

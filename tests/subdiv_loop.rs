@@ -5,8 +5,9 @@ mod common;
 
 use common::meshes::{icosahedron, jitter, octahedron, tri_grid};
 use common::surface_checks::{
-    assert_c1_across_edges, assert_corners_are_limit_points, assert_edge_curve_is_cubic_bspline,
-    assert_same_limit_point, close, eval_checking_first_derivatives,
+    assert_c1_across_edges, assert_corners_are_limit_points,
+    assert_derivatives_match_finite_differences, assert_edge_curve_is_cubic_bspline,
+    assert_same_limit_point, close,
 };
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
@@ -252,21 +253,12 @@ fn open_boundary_limit_curve_is_the_cubic_bspline_of_the_boundary() {
 fn derivatives_match_finite_differences() {
     let mesh = jitter(&icosahedron(), 0.2, 9);
     let s = loop_surface(&mesh);
-    let h = 1e-6;
-    for f in 0..mesh.num_faces() as u32 {
-        for &(u, v) in &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.2), (0.3, 0.6)] {
-            let (e, d) = eval_checking_first_derivatives(
-                &s,
-                (f, u, v),
-                h,
-                format_args!("face {f} ({u},{v})"),
-            );
-            assert!(
-                close(d.du_u, e.duu, 1e-5) && close(d.du_v, e.duv, 1e-5),
-                "face {f} ({u},{v}) second"
-            );
-        }
-    }
+    assert_derivatives_match_finite_differences(
+        &s,
+        0..mesh.num_faces() as u32,
+        &[(0.2, 0.3), (0.05, 0.1), (0.6, 0.2), (0.3, 0.6)],
+        |e, d| close(d.du_u, e.duu, 1e-5) && close(d.du_v, e.duv, 1e-5),
+    );
 }
 
 #[test]

@@ -158,26 +158,32 @@ pub struct CentralDifferences {
     pub dv_v: Vec3,
 }
 
-/// The evaluation of `s` at `(patch, u, v)`, with its first derivatives checked against central
-/// differences of step `h` (to 1e-6; `what` names the place), and those differences.
-pub fn eval_checking_first_derivatives(
+/// At each of `params` on each of `patches`, S_u and S_v agree with central differences of step
+/// 1e-6 to 1e-6, and `second(e, d)` holds (the second derivatives a scheme's test compares with
+/// the differences `d`).
+pub fn assert_derivatives_match_finite_differences(
     s: &SubdivSurface,
-    (patch, u, v): (u32, f64, f64),
-    h: f64,
-    what: std::fmt::Arguments,
-) -> (LimitEval, CentralDifferences) {
-    let e = s.eval(SurfaceParam { patch, u, v });
-    let at = |u: f64, v: f64| s.eval(SurfaceParam { patch, u, v });
-    let d = CentralDifferences {
-        point_u: (at(u + h, v).point - at(u - h, v).point) / (2.0 * h),
-        point_v: (at(u, v + h).point - at(u, v - h).point) / (2.0 * h),
-        du_u: (at(u + h, v).du - at(u - h, v).du) / (2.0 * h),
-        du_v: (at(u, v + h).du - at(u, v - h).du) / (2.0 * h),
-        dv_v: (at(u, v + h).dv - at(u, v - h).dv) / (2.0 * h),
-    };
-    assert!(
-        close(d.point_u, e.du, 1e-6) && close(d.point_v, e.dv, 1e-6),
-        "{what}"
-    );
-    (e, d)
+    patches: impl IntoIterator<Item = u32>,
+    params: &[(f64, f64)],
+    second: impl Fn(&LimitEval, &CentralDifferences) -> bool,
+) {
+    let h = 1e-6;
+    for patch in patches {
+        for &(u, v) in params {
+            let e = s.eval(SurfaceParam { patch, u, v });
+            let at = |u: f64, v: f64| s.eval(SurfaceParam { patch, u, v });
+            let d = CentralDifferences {
+                point_u: (at(u + h, v).point - at(u - h, v).point) / (2.0 * h),
+                point_v: (at(u, v + h).point - at(u, v - h).point) / (2.0 * h),
+                du_u: (at(u + h, v).du - at(u - h, v).du) / (2.0 * h),
+                du_v: (at(u, v + h).du - at(u, v - h).du) / (2.0 * h),
+                dv_v: (at(u, v + h).dv - at(u, v - h).dv) / (2.0 * h),
+            };
+            assert!(
+                close(d.point_u, e.du, 1e-6) && close(d.point_v, e.dv, 1e-6),
+                "patch {patch} ({u},{v})"
+            );
+            assert!(second(&e, &d), "patch {patch} ({u},{v}) second");
+        }
+    }
 }
