@@ -5,7 +5,9 @@
 mod common;
 
 use common::{geofit, geofit_ok, read_json, Rng};
-use geofit::fit::{FitData, FitError, FitReport, FitSpec, FitStatus, Scheme};
+use geofit::fit::{
+    FitData, FitError, FitReport, FitSpec, FitStatus, Fitter, ReconstructionReport, Scheme,
+};
 use geofit::geom::Point3;
 use geofit::mesh::PolyMesh;
 use std::path::{Path, PathBuf};
@@ -47,22 +49,25 @@ fn spec(avg: f64, max: f64) -> FitSpec {
         .with_max_control(Some(1_000))
 }
 
+/// The fitter of `spec` for the bare `points`, with what its reconstruction reported.
+fn build_from_points(spec: &FitSpec, points: &[Point3]) -> (Box<dyn Fitter>, ReconstructionReport) {
+    let data = PolyMesh::from_points(points.to_vec()).expect("finite points");
+    let fitter = spec.build(&FitData::points(&data)).expect("a fitter");
+    let rec = fitter
+        .log()
+        .reconstruction()
+        .cloned()
+        .expect("reconstructed");
+    (fitter, rec)
+}
+
 #[test]
 fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
     let mut points = ellipsoid(2_000);
     // Every tenth point twice: duplicates must not disturb normals or the fit.
     let twice: Vec<Point3> = points.iter().step_by(10).copied().collect();
     points.extend(twice);
-    let data = PolyMesh::from_points(points.clone()).expect("finite points");
-    let mut fitter = spec(0.05, 0.3)
-        .with_initial(Some(80))
-        .build(&FitData::points(&data))
-        .expect("a fitter");
-    let rec = fitter
-        .log()
-        .reconstruction()
-        .cloned()
-        .expect("reconstructed");
+    let (mut fitter, rec) = build_from_points(&spec(0.05, 0.3).with_initial(Some(80)), &points);
     assert_eq!((rec.kind, rec.method), ("closed", "implicit"));
     assert!(rec.triangles > 500, "{rec:?}");
     assert_eq!(
@@ -85,15 +90,9 @@ fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
 #[test]
 fn open_noisy_cloud_drops_outliers_and_reports_the_share_within_tolerance() {
     let points = noisy_sheet();
-    let data = PolyMesh::from_points(points.clone()).expect("finite points");
     let mut spec = spec(0.1, 0.5);
     spec.outliers = Some(3.0);
-    let mut fitter = spec.build(&FitData::points(&data)).expect("a fitter");
-    let rec = fitter
-        .log()
-        .reconstruction()
-        .cloned()
-        .expect("reconstructed");
+    let (mut fitter, rec) = build_from_points(&spec, &points);
     assert_eq!((rec.kind, rec.method), ("open", "delaunay"));
     assert_eq!(rec.outliers, 2, "{rec:?}");
     assert_eq!(
