@@ -7,7 +7,7 @@ use common::meshes::{cube, jitter, quad_grid};
 use common::surface_checks::{
     assert_c1_across_edges, assert_corners_are_limit_points,
     assert_derivatives_match_finite_differences, assert_edge_curve_is_cubic_bspline,
-    assert_same_limit_point, bspline, close, normal,
+    assert_same_limit_point, bspline, close, normal, refinement_invariance_tests,
 };
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
@@ -79,23 +79,11 @@ fn check_refinement_invariance(mesh: &PolyMesh) {
     }
 }
 
-#[test]
-fn refined_cube_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(&cube(), 0.1, 1));
-}
-
-#[test]
-fn refined_open_grid_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(
-        &quad_grid(4, |x, y| 0.3 * (x * 0.8).sin() * y),
-        0.1,
-        2,
-    ));
-}
-
-#[test]
-fn refined_quad_dominant_spot_has_the_same_limit_surface() {
-    check_refinement_invariance(&spot_quads());
+refinement_invariance_tests! {
+    refined_cube_has_the_same_limit_surface: jitter(&cube(), 0.1, 1);
+    refined_open_grid_has_the_same_limit_surface:
+        jitter(&quad_grid(4, |x, y| 0.3 * (x * 0.8).sin() * y), 0.1, 2);
+    refined_quad_dominant_spot_has_the_same_limit_surface: spot_quads();
 }
 
 #[test]

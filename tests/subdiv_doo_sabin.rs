@@ -8,6 +8,7 @@ mod common;
 use common::meshes::{cube, icosahedron, jitter, quad_grid};
 use common::surface_checks::{
     assert_derivatives_match_finite_differences, assert_same_limit_point, close,
+    refinement_invariance_tests,
 };
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
@@ -184,14 +185,9 @@ fn check_refinement_invariance(mesh: &PolyMesh) {
     }
 }
 
-#[test]
-fn refined_icosahedron_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(&icosahedron(), 0.2, 4));
-}
-
-#[test]
-fn refined_cube_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(&cube(), 0.1, 5));
+refinement_invariance_tests! {
+    refined_icosahedron_has_the_same_limit_surface: jitter(&icosahedron(), 0.2, 4);
+    refined_cube_has_the_same_limit_surface: jitter(&cube(), 0.1, 5);
 }
 
 #[test]

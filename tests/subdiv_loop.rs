@@ -7,7 +7,7 @@ use common::meshes::{icosahedron, jitter, octahedron, tri_grid};
 use common::surface_checks::{
     assert_c1_across_edges, assert_corners_are_limit_points,
     assert_derivatives_match_finite_differences, assert_edge_curve_is_cubic_bspline,
-    assert_same_limit_point, close,
+    assert_same_limit_point, close, refinement_invariance_tests,
 };
 use geofit::geom::Point3;
 use geofit::mesh::{ControlMesh, PolyMesh};
@@ -93,23 +93,11 @@ fn check_refinement_invariance(mesh: &PolyMesh) {
     }
 }
 
-#[test]
-fn refined_icosahedron_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(&icosahedron(), 0.2, 1));
-}
-
-#[test]
-fn refined_octahedron_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(&octahedron(), 0.2, 2));
-}
-
-#[test]
-fn refined_open_grid_has_the_same_limit_surface() {
-    check_refinement_invariance(&jitter(
-        &tri_grid(4, |x, y| (x * 0.7).sin() + 0.3 * y * y),
-        0.1,
-        3,
-    ));
+refinement_invariance_tests! {
+    refined_icosahedron_has_the_same_limit_surface: jitter(&icosahedron(), 0.2, 1);
+    refined_octahedron_has_the_same_limit_surface: jitter(&octahedron(), 0.2, 2);
+    refined_open_grid_has_the_same_limit_surface:
+        jitter(&tri_grid(4, |x, y| (x * 0.7).sin() + 0.3 * y * y), 0.1, 3);
 }
 
 #[test]

@@ -187,3 +187,17 @@ pub fn assert_derivatives_match_finite_differences(
         }
     }
 }
+
+/// One `#[test]` per `name: mesh;`, each checking with the calling file's
+/// `check_refinement_invariance` that the once-refined mesh has the same limit surface.
+#[allow(unused_macros)]
+macro_rules! refinement_invariance_tests {
+    ($($test:ident: $mesh:expr;)*) => {$(
+        #[test]
+        fn $test() {
+            check_refinement_invariance(&$mesh);
+        }
+    )*};
+}
+#[allow(unused_imports)]
+pub(crate) use refinement_invariance_tests;
