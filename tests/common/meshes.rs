@@ -45,26 +45,21 @@ pub fn icosahedron() -> PolyMesh {
     PolyMesh::try_new(p, f).unwrap()
 }
 
-/// Octahedron: valence 4 everywhere.
+/// Octahedron: valence 4 everywhere. Its vertices are ±x, ±y, ±z; its faces go round the ring
+/// x, y, −x, −y, first under +z, then (the other way) over −z.
 pub fn octahedron() -> PolyMesh {
     let p = vec![
-        Point3::new(1.0, 0.0, 0.0),
-        Point3::new(-1.0, 0.0, 0.0),
-        Point3::new(0.0, 1.0, 0.0),
-        Point3::new(0.0, -1.0, 0.0),
-        Point3::new(0.0, 0.0, 1.0),
-        Point3::new(0.0, 0.0, -1.0),
+        Point3::X,
+        Point3::NEG_X,
+        Point3::Y,
+        Point3::NEG_Y,
+        Point3::Z,
+        Point3::NEG_Z,
     ];
-    let f: Vec<[u32; 3]> = vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ];
+    let ring = [0, 2, 1, 3];
+    let upper = (0..4).map(|i| [ring[i], ring[(i + 1) % 4], 4]);
+    let lower = (0..4).map(|i| [ring[(i + 1) % 4], ring[i], 5]);
+    let f: Vec<[u32; 3]> = upper.chain(lower).collect();
     PolyMesh::try_new(p, f).unwrap()
 }
 
@@ -80,32 +75,36 @@ fn grid_points(n: usize, h: impl Fn(f64, f64) -> f64) -> Vec<Point3> {
     p
 }
 
-/// An n × n grid of unit squares in the plane z = h(x, y), each split into two triangles along
-/// the same diagonal (a regular triangulation: interior valence 6).
-pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
-    let p = grid_points(n, h);
+/// The faces `cell([a, b, c, d])` of the squares of an n × n grid, row by row, where a, b, c, d
+/// are the ids of the square's corners (i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1) in
+/// `grid_points`.
+fn grid_faces<F, const K: usize>(n: usize, cell: impl Fn([u32; 4]) -> [F; K]) -> Vec<F> {
     let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
     let mut f = Vec::new();
     for j in 0..n {
         for i in 0..n {
-            f.push([id(i, j), id(i + 1, j), id(i, j + 1)]);
-            f.push([id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            f.extend(cell([
+                id(i, j),
+                id(i + 1, j),
+                id(i + 1, j + 1),
+                id(i, j + 1),
+            ]));
         }
     }
-    PolyMesh::try_new(p, f).unwrap()
+    f
+}
+
+/// An n × n grid of unit squares in the plane z = h(x, y), each split into two triangles along
+/// the same diagonal (a regular triangulation: interior valence 6).
+pub fn tri_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
+    let f = grid_faces(n, |[a, b, c, d]| [[a, b, d], [b, c, d]]);
+    PolyMesh::try_new(grid_points(n, h), f).unwrap()
 }
 
 /// An n × n quad grid in the plane z = h(x, y).
 pub fn quad_grid(n: usize, h: impl Fn(f64, f64) -> f64) -> PolyMesh {
-    let p = grid_points(n, h);
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut f = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    PolyMesh::try_new(p, f).unwrap()
+    let f = grid_faces(n, |corners| [corners]);
+    PolyMesh::try_new(grid_points(n, h), f).unwrap()
 }
 
 /// A cube of six quads (valence 3 everywhere).
