@@ -1,6 +1,18 @@
 //! Small macros that keep repeated shapes in one place: option setters and enums named by
 //! strings (one table of names per enum for Display, FromStr and serde).
 
+/// `impl Default` that returns the type's `DEFAULT` constant (options keep their defaults in a
+/// `const` so that other constants can build on them).
+macro_rules! default_is_const {
+    ($ty:ident) => {
+        impl Default for $ty {
+            fn default() -> Self {
+                $ty::DEFAULT
+            }
+        }
+    };
+}
+
 /// `with_*` setters of an options struct, one line each: `name(arg: Type) => |s| s.field;`
 /// sets that place of `self` to `arg`. Several types may share one list, written
 /// `setters!([A, B] { ... })` (options that embed the same part reach it through one path).

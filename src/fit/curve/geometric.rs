@@ -80,11 +80,7 @@ impl CurveFitOptions {
     }
 }
 
-impl Default for CurveFitOptions {
-    fn default() -> Self {
-        CurveFitOptions::DEFAULT
-    }
-}
+default_is_const!(CurveFitOptions);
 
 setters!(CurveFitOptions {
     /// Sets the iteration cap.

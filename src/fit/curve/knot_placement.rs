@@ -95,11 +95,7 @@ impl KnotPlacementOptions {
     }
 }
 
-impl Default for KnotPlacementOptions {
-    fn default() -> Self {
-        KnotPlacementOptions::DEFAULT
-    }
-}
+default_is_const!(KnotPlacementOptions);
 
 setters!(KnotPlacementOptions {
     /// Sets the standard-deviation bound, %.

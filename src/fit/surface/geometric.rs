@@ -92,11 +92,7 @@ impl GeometricSurfaceOptions {
     }
 }
 
-impl Default for GeometricSurfaceOptions {
-    fn default() -> Self {
-        GeometricSurfaceOptions::DEFAULT
-    }
-}
+default_is_const!(GeometricSurfaceOptions);
 
 setters!(GeometricSurfaceOptions {
     /// Sets the acceleration.

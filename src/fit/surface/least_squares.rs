@@ -106,11 +106,7 @@ impl LsqSurfaceOptions {
     }
 }
 
-impl Default for LsqSurfaceOptions {
-    fn default() -> Self {
-        LsqSurfaceOptions::DEFAULT
-    }
-}
+default_is_const!(LsqSurfaceOptions);
 
 setters!(LsqSurfaceOptions {
     /// Sets the number of solves per knot vector.

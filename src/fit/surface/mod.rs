@@ -234,11 +234,7 @@ impl SurfaceGrid {
     }
 }
 
-impl Default for SurfaceGrid {
-    fn default() -> Self {
-        SurfaceGrid::DEFAULT
-    }
-}
+default_is_const!(SurfaceGrid);
 
 setters!([SurfaceGrid, GeometricSurfaceOptions, LsqSurfaceOptions] {
     /// Sets the degree.
