@@ -348,6 +348,23 @@ impl Topo {
         }
     }
 
+    /// Limit stencils of vertices `0..n`: the Doo–Sabin ones when given (that scheme's limit
+    /// points come from the vertex faces, not from a mask), otherwise each vertex's
+    /// [`Topo::limit_stencil`].
+    pub fn limit_stencils(
+        &self,
+        scheme: Scheme,
+        n: usize,
+        doo_sabin: Option<Vec<Stencil>>,
+    ) -> Vec<Option<Stencil>> {
+        match doo_sabin {
+            Some(limits) => limits.into_iter().map(Some).collect(),
+            None => (0..n as u32)
+                .map(|v| self.limit_stencil(scheme, v))
+                .collect(),
+        }
+    }
+
     /// Exact limit position of vertex `v` as a stencil (limit mask), if its faces are present.
     pub fn limit_stencil(&self, scheme: Scheme, v: u32) -> Option<Stencil> {
         let edges = self.vertex_edges(v);
