@@ -14,18 +14,19 @@ macro_rules! default_is_const {
 }
 
 /// `with_*` setters of an options struct, one line each: `name(arg: Type) => |s| s.field;`
-/// sets that place of `self` to `arg`. Several types may share one list, written
+/// sets that place of `self` to `arg`; `name(a: A, b: B) => |s| s.x, s.y;` sets two places at
+/// once. Several types may share one list, written
 /// `setters!([A, B] { ... })` (options that embed the same part reach it through one path).
 macro_rules! setters {
     ([$($ty:ident),+] $body:tt) => {
         $(setters!($ty $body);)+
     };
-    ($ty:ident { $($(#[$doc:meta])* $name:ident($arg:ident: $t:ty) => |$s:ident| $place:expr;)* }) => {
+    ($ty:ident { $($(#[$doc:meta])* $name:ident($($arg:ident: $t:ty),+) => |$s:ident| $($place:expr),+;)* }) => {
         impl $ty {
             $($(#[$doc])*
-            pub fn $name(mut self, $arg: $t) -> Self {
+            pub fn $name(mut self, $($arg: $t),+) -> Self {
                 let $s = &mut self;
-                $place = $arg;
+                $($place = $arg;)+
                 self
             })*
         }

@@ -249,6 +249,11 @@ setters!([SurfaceGrid, GeometricSurfaceOptions, LsqSurfaceOptions] {
     with_param(param: ParamOptions) => |s| s.grid_mut().param;
 });
 
+setters!([GeometricSurfaceOptions, LsqSurfaceOptions] {
+    /// Sets the iteration cap.
+    with_max_iterations(max_iterations: usize) => |s| s.max_iterations;
+});
+
 /// The setters that take two values, for every options type holding a [`SurfaceGrid`].
 macro_rules! grid_pair_setters {
     ($($ty:ty),+) => {$(
