@@ -35,7 +35,6 @@ below are computed from exactly the stored numbers, in f64):
 
 import json
 import struct
-import sys
 from pathlib import Path
 
 import laspy
@@ -47,13 +46,6 @@ import objfile
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "tests" / "data" / "formats"
-
-
-def data_dir() -> Path:
-    if len(sys.argv) > 1:
-        return Path(sys.argv[1])
-    beside = ROOT.parent / "shared" / "data"
-    return beside if beside.is_dir() else Path("/work/shared/data")
 
 
 def read_bun000(path: Path):
@@ -255,34 +247,25 @@ def write_pcd(bunny, expected):
     )
     ring = (np.arange(n) % 16).astype(np.uint16)
     t = np.arange(n, dtype=np.float64) * 1e-3
+    # Each file picks its fields, in its order, from these (values, stored type).
+    columns = {
+        "x": (x, np.float32),
+        "y": (y, np.float32),
+        "z": (z, np.float32),
+        "rgb": (rgb, np.float32),
+        "intensity": (intensity, np.float32),
+        "ring": (ring, np.uint16),
+        "t": (t, np.float64),
+    }
     clouds = [
-        (
-            "bunny-ascii.pcd",
-            Encoding.ASCII,
-            PointCloud.from_points(
-                [x, y, z, rgb], ("x", "y", "z", "rgb"), (np.float32,) * 3 + (np.float32,)
-            ),
-        ),
-        (
-            "bunny-binary.pcd",
-            Encoding.BINARY,
-            PointCloud.from_points(
-                [intensity, x, y, z, ring],
-                ("intensity", "x", "y", "z", "ring"),
-                (np.float32, np.float32, np.float32, np.float32, np.uint16),
-            ),
-        ),
-        (
-            "bunny-compressed.pcd",
-            Encoding.BINARY_COMPRESSED,
-            PointCloud.from_points(
-                [x, y, z, intensity, t],
-                ("x", "y", "z", "intensity", "t"),
-                (np.float32, np.float32, np.float32, np.float32, np.float64),
-            ),
-        ),
+        ("bunny-ascii.pcd", Encoding.ASCII, ("x", "y", "z", "rgb")),
+        ("bunny-binary.pcd", Encoding.BINARY, ("intensity", "x", "y", "z", "ring")),
+        ("bunny-compressed.pcd", Encoding.BINARY_COMPRESSED, ("x", "y", "z", "intensity", "t")),
     ]
-    for name, encoding, pc in clouds:
+    for name, encoding, fields in clouds:
+        pc = PointCloud.from_points(
+            [columns[f][0] for f in fields], fields, tuple(columns[f][1] for f in fields)
+        )
         pc.save(OUT / name, encoding=encoding)
         back = PointCloud.from_path(OUT / name).numpy(("x", "y", "z")).astype(np.float64)
         expected[name] = summary(back, grid=None)
@@ -523,7 +506,7 @@ def write_glb(suz_v, suz_f, expected):
 
 
 def main():
-    data = data_dir()
+    data = objfile.data_dir()
     OUT.mkdir(parents=True, exist_ok=True)
     verts, grid = read_bun000(data / "bun000.ply")
     bunny, _ = read_obj(data / "stanford-bunny.obj")

@@ -9,7 +9,6 @@ Run once by hand (the outputs are committed):
 - bun000-points.xyz: every 8th point of the raw range scan bun000.ply, as plain x y z text.
 """
 
-import sys
 from pathlib import Path
 
 import fast_simplification
@@ -21,13 +20,6 @@ ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "www" / "samples"
 TARGET_VERTICES = 2000
 POINT_STRIDE = 8
-
-
-def data_dir() -> Path:
-    if len(sys.argv) > 1:
-        return Path(sys.argv[1])
-    beside = ROOT.parent / "shared" / "data"
-    return beside if beside.is_dir() else Path("/work/shared/data")
 
 
 def read_obj(path: Path):
@@ -63,6 +55,6 @@ def write_points(data: Path) -> None:
 
 if __name__ == "__main__":
     OUT.mkdir(parents=True, exist_ok=True)
-    data = data_dir()
+    data = objfile.data_dir()
     write_bunny(data)
     write_points(data)

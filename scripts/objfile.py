@@ -1,7 +1,20 @@
-"""Reading OBJ meshes for the scripts that make geofit's test data and samples."""
+"""Helpers shared by the scripts that make geofit's test data and samples: where the source
+scans are, and reading OBJ meshes."""
+import sys
 from pathlib import Path
 
 import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def data_dir() -> Path:
+    """The folder of the source scans: the first command-line argument, else ../shared/data
+    beside the checkout, else /work/shared/data."""
+    if len(sys.argv) > 1:
+        return Path(sys.argv[1])
+    beside = ROOT.parent / "shared" / "data"
+    return beside if beside.is_dir() else Path("/work/shared/data")
 
 
 def read_obj(path, triangulate=True):

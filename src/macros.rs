@@ -1,19 +1,32 @@
 //! Small macros that keep repeated shapes in one place: option setters and enums named by
 //! strings (one table of names per enum for Display, FromStr and serde).
 
+/// `impl Default` that returns the type's `DEFAULT` constant (options keep their defaults in a
+/// `const` so that other constants can build on them).
+macro_rules! default_is_const {
+    ($ty:ident) => {
+        impl Default for $ty {
+            fn default() -> Self {
+                $ty::DEFAULT
+            }
+        }
+    };
+}
+
 /// `with_*` setters of an options struct, one line each: `name(arg: Type) => |s| s.field;`
-/// sets that place of `self` to `arg`. Several types may share one list, written
+/// sets that place of `self` to `arg`; `name(a: A, b: B) => |s| s.x, s.y;` sets two places at
+/// once. Several types may share one list, written
 /// `setters!([A, B] { ... })` (options that embed the same part reach it through one path).
 macro_rules! setters {
     ([$($ty:ident),+] $body:tt) => {
         $(setters!($ty $body);)+
     };
-    ($ty:ident { $($(#[$doc:meta])* $name:ident($arg:ident: $t:ty) => |$s:ident| $place:expr;)* }) => {
+    ($ty:ident { $($(#[$doc:meta])* $name:ident($($arg:ident: $t:ty),+) => |$s:ident| $($place:expr),+;)* }) => {
         impl $ty {
             $($(#[$doc])*
-            pub fn $name(mut self, $arg: $t) -> Self {
+            pub fn $name(mut self, $($arg: $t),+) -> Self {
                 let $s = &mut self;
-                $place = $arg;
+                $($place = $arg;)+
                 self
             })*
         }

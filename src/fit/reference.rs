@@ -319,15 +319,10 @@ fn sagitta(corners: [Point3; 3], normals: [Vec3; 3]) -> f64 {
 /// Area-weighted vertex normals of `triangles` (zero for a vertex of no or only degenerate
 /// triangles).
 fn vertex_normals(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut normals = vec![Vec3::ZERO; positions.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| positions[i as usize]);
-        let n = (b - a).cross(c - a);
-        for &v in t {
-            normals[v as usize] += n;
-        }
-    }
-    normals.iter().map(|n| n.normalize_or_zero()).collect()
+    crate::geom::area_weighted_normal_sums(positions, triangles)
+        .iter()
+        .map(|n| n.normalize_or_zero())
+        .collect()
 }
 
 /// Which part of a triangle a closest point lies on.

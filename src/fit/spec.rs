@@ -462,11 +462,7 @@ macro_rules! spec_fields {
     };
 }
 
-impl Default for FitSpec {
-    fn default() -> Self {
-        FitSpec::DEFAULT
-    }
-}
+default_is_const!(FitSpec);
 
 impl FitSpec {
     /// Every field at its default: a Loop fit with the scheme's defaults.

@@ -14,11 +14,7 @@ pub struct Tolerances {
     pub rms_pct: Option<f64>,
 }
 
-impl Default for Tolerances {
-    fn default() -> Self {
-        Tolerances::DEFAULT
-    }
-}
+default_is_const!(Tolerances);
 
 impl Tolerances {
     /// The specification's tolerances (SPEC §1, the patent's Table 1): E_avg 0.01 %, E_max

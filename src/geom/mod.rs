@@ -13,3 +13,17 @@ pub use nearest::{ClosestPoint, Nearest, NewtonOptions};
 pub type Point3 = glam::DVec3;
 /// A vector in 3D space (f64).
 pub type Vec3 = glam::DVec3;
+
+/// Per vertex, the sum of the (unnormalised) normals of its triangles: each weighs by twice its
+/// area. Callers normalise as their format needs (a vertex on no triangle sums to zero).
+pub(crate) fn area_weighted_normal_sums(positions: &[Point3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut sums = vec![Vec3::ZERO; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        let n = (b - a).cross(c - a);
+        for &v in t {
+            sums[v as usize] += n;
+        }
+    }
+    sums
+}

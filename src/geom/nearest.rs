@@ -71,11 +71,7 @@ impl NewtonOptions {
     }
 }
 
-impl Default for NewtonOptions {
-    fn default() -> Self {
-        NewtonOptions::DEFAULT
-    }
-}
+default_is_const!(NewtonOptions);
 
 /// A shape that finds its point nearest to a query point by Newton's method from a starting
 /// parameter.

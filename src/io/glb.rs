@@ -9,7 +9,7 @@
 //! metres: a mesh in other units gets a uniform scale on its node, so the stored coordinates
 //! stay the ones the fit produced. A mesh without faces is written as a point primitive.
 
-use super::write::WriteError;
+use super::write::{checked_f32, WriteError};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::PolyMesh;
 use serde_json::{json, Value};
@@ -195,15 +195,7 @@ fn invalid(what: String) -> WriteError {
 }
 
 fn f32_of(x: f64) -> Result<f32, WriteError> {
-    let y = x as f32;
-    if y.is_finite() {
-        Ok(y)
-    } else {
-        Err(WriteError::TooLarge {
-            format: "GLB",
-            what: format!("value {x:e} exceeds the f32 range"),
-        })
-    }
+    checked_f32(x, "GLB", "value")
 }
 
 /// The binary chunk under construction and the JSON describing its views and accessors.
@@ -215,6 +207,22 @@ struct Bin {
 }
 
 impl Bin {
+    /// Appends a per-vertex float VEC3 attribute (one entry per vertex) and names it in
+    /// `attributes`.
+    fn push_vec3_attribute(
+        &mut self,
+        attributes: &mut serde_json::Map<String, Value>,
+        name: &str,
+        values: &[[f32; 3]],
+    ) {
+        let a = self.push(
+            &vec3_bytes(values),
+            ARRAY_BUFFER,
+            json!({ "componentType": FLOAT, "count": values.len(), "type": "VEC3" }),
+        );
+        attributes.insert(name.into(), json!(a));
+    }
+
     /// Appends a tightly packed view of `bytes`, 4-byte aligned, and an accessor over it.
     fn push(&mut self, bytes: &[u8], target: u32, accessor: Value) -> usize {
         while self.data.len() % 4 != 0 {
@@ -241,15 +249,10 @@ fn vec3_bytes(v: &[[f32; 3]]) -> Vec<u8> {
 /// Area-weighted vertex normals (f64), unit length; a vertex in no non-degenerate triangle
 /// gets +z, since glTF requires unit normals.
 fn vertex_normals(p: &[Point3], tris: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut n = vec![Vec3::ZERO; p.len()];
-    for t in tris {
-        let [a, b, c] = t.map(|i| p[i as usize]);
-        let face = (b - a).cross(c - a);
-        for &i in t {
-            n[i as usize] += face;
-        }
-    }
-    n.into_iter().map(unit_or_z).collect()
+    crate::geom::area_weighted_normal_sums(p, tris)
+        .into_iter()
+        .map(unit_or_z)
+        .collect()
 }
 
 fn unit_or_z(v: Vec3) -> Vec3 {
@@ -314,12 +317,7 @@ pub fn to_glb_bytes(mesh: &PolyMesh, options: &GlbOptions) -> Result<Vec<u8>, Wr
             .iter()
             .map(|v| [v.x as f32, v.y as f32, v.z as f32])
             .collect();
-        let a = bin.push(
-            &vec3_bytes(&normals),
-            ARRAY_BUFFER,
-            json!({ "componentType": FLOAT, "count": n, "type": "VEC3" }),
-        );
-        attributes.insert("NORMAL".into(), json!(a));
+        bin.push_vec3_attribute(&mut attributes, "NORMAL", &normals);
     }
 
     if let Some(dev) = options.deviation {
@@ -349,12 +347,7 @@ pub fn to_glb_bytes(mesh: &PolyMesh, options: &GlbOptions) -> Result<Vec<u8>, Wr
                 c.map(srgb_to_linear)
             })
             .collect();
-        let a = bin.push(
-            &vec3_bytes(&colours),
-            ARRAY_BUFFER,
-            json!({ "componentType": FLOAT, "count": n, "type": "VEC3" }),
-        );
-        attributes.insert("COLOR_0".into(), json!(a));
+        bin.push_vec3_attribute(&mut attributes, "COLOR_0", &colours);
         let values: Vec<u8> = dev
             .iter()
             .map(|&d| f32_of(d).map(f32::to_le_bytes))

@@ -190,6 +190,17 @@ pub fn read_bytes(bytes: &[u8], name: Option<&str>) -> Result<LoadedFile, ReadEr
     Ok(loaded)
 }
 
+/// The mesh of a reader that collects faces flat: face k's corners are
+/// `face_indices[face_starts[k]..face_starts[k + 1]]`.
+fn mesh_from_flat_faces(
+    positions: Vec<crate::geom::Point3>,
+    face_starts: &[usize],
+    face_indices: &[u32],
+) -> Result<PolyMesh, ReadError> {
+    let faces = face_starts.windows(2).map(|w| &face_indices[w[0]..w[1]]);
+    Ok(PolyMesh::try_new(positions, faces)?)
+}
+
 /// The error for a format whose reader was left out of the build by its cargo feature.
 #[cfg(any(not(feature = "e57"), not(feature = "laz")))]
 fn not_built(format: Format, feature: &str) -> ReadError {

@@ -2,9 +2,8 @@
 //! polylines. Every other statement (`vt`, `vn`, groups, materials, …) is ignored.
 
 use super::text::{coordinate, lines, parse_i64, show, tokens};
-use super::{Format, LoadedFile, Location, ReadError};
+use super::{mesh_from_flat_faces, Format, LoadedFile, Location, ReadError};
 use crate::geom::Point3;
-use crate::mesh::PolyMesh;
 
 const OBJ: Format = Format::Obj;
 
@@ -62,11 +61,7 @@ fn finish(p: Parsed) -> Result<LoadedFile, ReadError> {
             count,
         });
     }
-    let faces = p
-        .face_starts
-        .windows(2)
-        .map(|w| &p.face_indices[w[0]..w[1]]);
-    let mesh = PolyMesh::try_new(p.positions, faces)?;
+    let mesh = mesh_from_flat_faces(p.positions, &p.face_starts, &p.face_indices)?;
     Ok(LoadedFile {
         polylines: p.polylines,
         ..LoadedFile::from_mesh(OBJ, mesh)

@@ -8,9 +8,8 @@
 mod body;
 mod header;
 
-use super::{Format, LoadedFile, Location, RangeGrid, ReadError};
+use super::{mesh_from_flat_faces, Format, LoadedFile, Location, RangeGrid, ReadError};
 use crate::geom::Point3;
-use crate::mesh::PolyMesh;
 use body::{Ascii, Binary, Body, Fault};
 use header::{Element, Encoding, Header, PropKind};
 
@@ -76,11 +75,7 @@ fn read_body<B: Body>(mut body: B, header: &Header) -> Result<LoadedFile, ReadEr
 
 fn finish(mut p: Parsed, header: &Header, has_z: bool) -> Result<LoadedFile, ReadError> {
     let range_grid = grid(std::mem::take(&mut p.grid_cells), header)?;
-    let faces = p
-        .face_starts
-        .windows(2)
-        .map(|w| &p.face_indices[w[0]..w[1]]);
-    let mesh = PolyMesh::try_new(p.positions, faces)?;
+    let mesh = mesh_from_flat_faces(p.positions, &p.face_starts, &p.face_indices)?;
     Ok(LoadedFile {
         range_grid,
         dimension: if has_z { 3 } else { 2 },
@@ -198,27 +193,22 @@ fn read_index_list<B: Body>(
 
 fn fault_error(fault: Fault, at: Location, el: &Element, i: usize, prop: &str) -> ReadError {
     let what = format!("property '{prop}' of {} {i} (of {})", el.name, el.count);
-    match fault {
-        Fault::End => ReadError::Truncated {
-            format: PLY,
-            at,
-            message: format!("while reading {what}"),
-        },
-        Fault::NotNumber(token) => ReadError::Syntax {
-            format: PLY,
-            at,
-            message: format!("expected a number for {what}, found '{token}'"),
-        },
-        Fault::NotInteger(token) => ReadError::Syntax {
-            format: PLY,
-            at,
-            message: format!("expected an integer for {what}, found '{token}'"),
-        },
-        Fault::NegativeLength(n) => ReadError::Syntax {
-            format: PLY,
-            at,
-            message: format!("list length {n} is negative in {what}"),
-        },
+    let message = match fault {
+        Fault::End => {
+            return ReadError::Truncated {
+                format: PLY,
+                at,
+                message: format!("while reading {what}"),
+            }
+        }
+        Fault::NotNumber(token) => format!("expected a number for {what}, found '{token}'"),
+        Fault::NotInteger(token) => format!("expected an integer for {what}, found '{token}'"),
+        Fault::NegativeLength(n) => format!("list length {n} is negative in {what}"),
+    };
+    ReadError::Syntax {
+        format: PLY,
+        at,
+        message,
     }
 }
 
@@ -390,22 +380,25 @@ mod tests {
         assert!(e.to_string().starts_with("PLY line 10: "), "{e}");
         let e = read(&ascii(TRI, "0 0 0\n1 0 0\n")).unwrap_err();
         assert!(matches!(e, ReadError::Truncated { .. }), "{e}");
-        let src = ascii(
-            &format!("{TRI}element face 1\nproperty list uchar int vertex_indices\n"),
-            "0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
-        );
-        assert_eq!(
-            read(&src).unwrap_err().to_string(),
-            "PLY line 14: vertex index 3 is out of range (the file has 3 vertices)"
-        );
-        let src = ascii(
-            &format!("{TRI}element face 1\nproperty list char int vertex_indices\n"),
-            "0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n",
-        );
-        assert_eq!(
-            read(&src).unwrap_err().to_string(),
-            "PLY line 14: list length -3 is negative in property 'vertex_indices' of face 0 (of 1)"
-        );
+        // One bad face after three good vertices: (list length type, face line, error).
+        for (count, face, message) in [
+            (
+                "uchar",
+                "3 0 1 3",
+                "PLY line 14: vertex index 3 is out of range (the file has 3 vertices)",
+            ),
+            (
+                "char",
+                "-3 0 1 2",
+                "PLY line 14: list length -3 is negative in property 'vertex_indices' of face 0 (of 1)",
+            ),
+        ] {
+            let src = ascii(
+                &format!("{TRI}element face 1\nproperty list {count} int vertex_indices\n"),
+                &format!("0 0 0\n1 0 0\n0 1 0\n{face}\n"),
+            );
+            assert_eq!(read(&src).unwrap_err().to_string(), message);
+        }
         let e = read(&ascii(TRI, "0 0 0\n1 inf 0\n0 1 0\n")).unwrap_err();
         assert_eq!(
             e.to_string(),

@@ -245,6 +245,24 @@ fn numbers<const N: usize>(lines: &mut Lines, what: &str) -> Result<[f64; N], Re
         at: Location::Line(lines.last + 1),
         message: format!("the scan header ends before the {what}"),
     })?;
+    leading_numbers(line, line_no, |k| {
+        format!("expected {N} numbers for the {what}, found {k}")
+    })
+}
+
+fn point(line: &[u8], line_no: usize) -> Result<[f64; 3], ReadError> {
+    leading_numbers(line, line_no, |k| {
+        format!("expected a point 'x y z [intensity [r g b]]', found {k} numbers")
+    })
+}
+
+/// The first `N` numbers of `line` (more may follow); `missing(k)` words the error when the
+/// line has only k.
+fn leading_numbers<const N: usize>(
+    line: &[u8],
+    line_no: usize,
+    missing: impl Fn(usize) -> String,
+) -> Result<[f64; N], ReadError> {
     let at = Location::Line(line_no);
     let mut out = [0.0; N];
     let mut t = tokens(line);
@@ -252,22 +270,7 @@ fn numbers<const N: usize>(lines: &mut Lines, what: &str) -> Result<[f64; N], Re
         let tok = t.next().ok_or_else(|| ReadError::Syntax {
             format: PTX,
             at,
-            message: format!("expected {N} numbers for the {what}, found {k}"),
-        })?;
-        *v = coordinate(tok, PTX, at)?;
-    }
-    Ok(out)
-}
-
-fn point(line: &[u8], line_no: usize) -> Result<[f64; 3], ReadError> {
-    let at = Location::Line(line_no);
-    let mut out = [0.0; 3];
-    let mut t = tokens(line);
-    for (k, v) in out.iter_mut().enumerate() {
-        let tok = t.next().ok_or_else(|| ReadError::Syntax {
-            format: PTX,
-            at,
-            message: format!("expected a point 'x y z [intensity [r g b]]', found {k} numbers"),
+            message: missing(k),
         })?;
         *v = coordinate(tok, PTX, at)?;
     }

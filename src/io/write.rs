@@ -146,15 +146,20 @@ impl std::fmt::Display for Decimal {
     }
 }
 
-/// `x` rounded to f32, or an error where it overflows to infinity.
 fn to_f32(x: f64) -> Result<f32, WriteError> {
+    checked_f32(x, "STL", "coordinate")
+}
+
+/// `x` rounded to f32, or an error where it overflows to infinity; the message calls `x` a
+/// `what` of `format` (the writers that store f32 share it).
+pub(super) fn checked_f32(x: f64, format: &'static str, what: &str) -> Result<f32, WriteError> {
     let y = x as f32;
     if y.is_finite() {
         Ok(y)
     } else {
         Err(WriteError::TooLarge {
-            format: "STL",
-            what: format!("coordinate {x:e} exceeds the f32 range"),
+            format,
+            what: format!("{what} {x:e} exceeds the f32 range"),
         })
     }
 }

@@ -261,6 +261,19 @@ impl ControlMesh {
         self.face_half_edges(f).count()
     }
 
+    /// Fails unless face `f` is a triangle: flips and edge splits are defined on triangles only.
+    fn check_triangle(&self, f: u32) -> Result<(), TopologyError> {
+        let len = self.face_len(f);
+        if len == 3 {
+            return Ok(());
+        }
+        Err(TopologyError::WrongFaceSize {
+            face: f as usize,
+            len,
+            needed: 3,
+        })
+    }
+
     /// Outgoing half-edges of `v` in counter-clockwise order (starting at the boundary one).
     pub fn outgoing(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
         let start = self.vert_he[v as usize];
@@ -377,14 +390,7 @@ impl ControlMesh {
             });
         }
         for f in [self.face[h as usize], self.face[t as usize]] {
-            let len = self.face_len(f);
-            if len != 3 {
-                return Err(TopologyError::WrongFaceSize {
-                    face: f as usize,
-                    len,
-                    needed: 3,
-                });
-            }
+            self.check_triangle(f)?;
         }
         let (h1, h2) = (self.next(h), self.prev(h));
         let (t1, t2) = (self.next(t), self.prev(t));
@@ -463,15 +469,7 @@ impl ControlMesh {
             if e == NONE {
                 continue;
             }
-            let f = self.face[e as usize];
-            let len = self.face_len(f);
-            if len != 3 {
-                return Err(TopologyError::WrongFaceSize {
-                    face: f as usize,
-                    len,
-                    needed: 3,
-                });
-            }
+            self.check_triangle(self.face[e as usize])?;
         }
         let m = self.positions.len() as u32;
         self.positions.push(point);

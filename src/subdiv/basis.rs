@@ -139,13 +139,23 @@ pub(crate) fn bicubic_lattice() -> [(i32, i32); 16] {
 /// Bicubic B-spline weights of the 16 points of [`bicubic_lattice`] at (u, v).
 #[cfg(test)]
 pub(crate) fn bicubic(u: f64, v: f64) -> Weights<16> {
-    let (bu, bv) = (cubic(u), cubic(v));
+    tensor_product(&cubic(u), &cubic(v))
+}
+
+/// Weights of a K × K tensor-product lattice, index `K j + i`, from the univariate bases in u
+/// and v (value, first, second derivative each); N = K².
+#[cfg(test)]
+fn tensor_product<const K: usize, const N: usize>(
+    bu: &[[f64; K]; 3],
+    bv: &[[f64; K]; 3],
+) -> Weights<N> {
+    assert_eq!(N, K * K);
     const ORDERS: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
-    let mut w = [[0.0; 16]; 6];
+    let mut w = [[0.0; N]; 6];
     for (d, &(ou, ov)) in ORDERS.iter().enumerate() {
-        for j in 0..4 {
-            for i in 0..4 {
-                w[d][4 * j + i] = bu[ou][i] * bv[ov][j];
+        for j in 0..K {
+            for i in 0..K {
+                w[d][K * j + i] = bu[ou][i] * bv[ov][j];
             }
         }
     }
@@ -172,17 +182,7 @@ fn quadratic(t: f64) -> [[f64; 3]; 3] {
 /// corners are the centroids of its four faces.
 #[cfg(test)]
 pub(crate) fn biquadratic(u: f64, v: f64) -> Weights<9> {
-    let (bu, bv) = (quadratic(u), quadratic(v));
-    const ORDERS: [(usize, usize); 6] = [(0, 0), (1, 0), (0, 1), (2, 0), (1, 1), (0, 2)];
-    let mut w = [[0.0; 9]; 6];
-    for (d, &(ou, ov)) in ORDERS.iter().enumerate() {
-        for j in 0..3 {
-            for i in 0..3 {
-                w[d][3 * j + i] = bu[ou][i] * bv[ov][j];
-            }
-        }
-    }
-    w
+    tensor_product(&quadratic(u), &quadratic(v))
 }
 
 /// A scheme's regular-patch basis rewritten in powers u^a v^b: patches are evaluated from

@@ -58,15 +58,8 @@ pub fn refine_levels(
 pub fn limit_positions(scheme: Scheme, mesh: &ControlMesh) -> Result<Vec<Point3>, SubdivError> {
     let topo = Topo::of_control_mesh(mesh);
     let p = mesh.positions();
-    let stencils: Vec<_> = match scheme {
-        Scheme::DooSabin => super::doo_sabin::vertex_limits(&topo)
-            .into_iter()
-            .map(Some)
-            .collect(),
-        _ => (0..mesh.num_vertices() as u32)
-            .map(|v| topo.limit_stencil(scheme, v))
-            .collect(),
-    };
+    let doo_sabin = (scheme == Scheme::DooSabin).then(|| super::doo_sabin::vertex_limits(&topo));
+    let stencils = topo.limit_stencils(scheme, mesh.num_vertices(), doo_sabin);
     stencils
         .into_iter()
         .map(|s| {

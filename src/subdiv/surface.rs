@@ -4,7 +4,7 @@
 use super::doo_sabin::limits_of;
 use super::patch::{neighbourhood, vertex_neighbourhood, Graph, Kind};
 use super::sites::DooSabinSites;
-use super::topo::{Stencil, Topo};
+use super::topo::Topo;
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::{ControlMesh, NONE};
@@ -213,15 +213,10 @@ impl SubdivSurface {
         }
         let mut limit_starts = vec![0u32];
         let mut limit_weights = Vec::new();
-        let stencils: Vec<Option<Stencil>> = match &doo_sabin {
-            Some(ds) => limits_of(&ds.ext, mesh.num_vertices())
-                .into_iter()
-                .map(Some)
-                .collect(),
-            None => (0..mesh.num_vertices() as u32)
-                .map(|v| topo.limit_stencil(scheme, v))
-                .collect(),
-        };
+        let ds_limits = doo_sabin
+            .as_ref()
+            .map(|ds| limits_of(&ds.ext, mesh.num_vertices()));
+        let stencils = topo.limit_stencils(scheme, mesh.num_vertices(), ds_limits);
         for s in stencils {
             limit_weights.extend(s.ok_or(SubdivError::Unevaluable { patch: 0 })?);
             limit_starts.push(limit_weights.len() as u32);

@@ -122,6 +122,20 @@ impl Topo {
             ..self.vert_edge_starts[v as usize + 1] as usize]
     }
 
+    /// The faces on `edges`, each once, in order of first appearance (the vertex stencils sum
+    /// over the faces around a vertex, which its edges reach).
+    fn faces_of_edges(&self, edges: &[u32]) -> Vec<u32> {
+        let mut faces = Vec::new();
+        for &e in edges {
+            for f in self.edge_faces[e as usize] {
+                if f != NO && !faces.contains(&f) {
+                    faces.push(f);
+                }
+            }
+        }
+        faces
+    }
+
     pub fn other_end(&self, e: u32, v: u32) -> u32 {
         let [a, b] = self.edges[e as usize];
         if a == v {
@@ -299,15 +313,7 @@ impl Topo {
                 let mut s = vec![(v, (n - 2.0) / n)];
                 let w = 1.0 / (n * n);
                 s.extend(edges.iter().map(|&e| (self.other_end(e, v), w)));
-                let mut faces = Vec::new();
-                for &e in edges {
-                    for f in self.edge_faces[e as usize] {
-                        if f != NO && !faces.contains(&f) {
-                            faces.push(f);
-                        }
-                    }
-                }
-                for f in faces {
+                for f in self.faces_of_edges(edges) {
                     for (u, fw) in self.face_point(f) {
                         s.push((u, w * fw));
                     }
@@ -339,6 +345,23 @@ impl Topo {
                 }
                 Some(merge(s))
             }
+        }
+    }
+
+    /// Limit stencils of vertices `0..n`: the Doo–Sabin ones when given (that scheme's limit
+    /// points come from the vertex faces, not from a mask), otherwise each vertex's
+    /// [`Topo::limit_stencil`].
+    pub fn limit_stencils(
+        &self,
+        scheme: Scheme,
+        n: usize,
+        doo_sabin: Option<Vec<Stencil>>,
+    ) -> Vec<Option<Stencil>> {
+        match doo_sabin {
+            Some(limits) => limits.into_iter().map(Some).collect(),
+            None => (0..n as u32)
+                .map(|v| self.limit_stencil(scheme, v))
+                .collect(),
         }
     }
 
@@ -379,15 +402,7 @@ impl Topo {
                 let d = nf * (nf + 5.0);
                 let mut s = vec![(v, nf * nf / d)];
                 s.extend(edges.iter().map(|&e| (self.other_end(e, v), 4.0 / d)));
-                let mut faces = Vec::new();
-                for &e in edges {
-                    for f in self.edge_faces[e as usize] {
-                        if f != NO && !faces.contains(&f) {
-                            faces.push(f);
-                        }
-                    }
-                }
-                for f in faces {
+                for f in self.faces_of_edges(edges) {
                     let c = self.face(f);
                     if c.len() != 4 {
                         return None;

@@ -92,15 +92,26 @@ fn from_edge(j: usize, t: f64, s: f64) -> (f64, f64) {
     }
 }
 
+/// The side of the unit square that (u, v) lies furthest beyond (0: v = 0, 1: u = 1, 2: v = 1,
+/// 3: u = 0), or `None` inside the square.
+fn exit_side(u: f64, v: f64) -> Option<usize> {
+    let out = [-v, u - 1.0, v - 1.0, -u];
+    let j = (0..4)
+        .max_by(|&a, &b| out[a].total_cmp(&out[b]))
+        .unwrap_or(0);
+    // Written so that a NaN coordinate keeps walking, as the loops always did.
+    if out[j] <= 0.0 {
+        None
+    } else {
+        Some(j)
+    }
+}
+
 fn walk_quads(mesh: &ControlMesh, mut f: u32, mut u: f64, mut v: f64) -> SurfaceParam {
     for _ in 0..MAX_STEPS {
-        let out = [-v, u - 1.0, v - 1.0, -u];
-        let j = (0..4)
-            .max_by(|&a, &b| out[a].total_cmp(&out[b]))
-            .unwrap_or(0);
-        if out[j] <= 0.0 {
+        let Some(j) = exit_side(u, v) else {
             break;
-        }
+        };
         let h = mesh.face_half_edges(f).nth(j).unwrap_or(NONE);
         let t = if h == NONE { NONE } else { mesh.twin(h) };
         if t == NONE {
@@ -136,13 +147,9 @@ pub(crate) fn walk_doo_sabin(ds: &DooSabinSites, patch: u32, u: f64, v: f64) -> 
         0
     };
     for _ in 0..MAX_STEPS {
-        let out = [-v, u - 1.0, v - 1.0, -u];
-        let j = (0..4)
-            .max_by(|&a, &b| out[a].total_cmp(&out[b]))
-            .unwrap_or(0);
-        if out[j] <= 0.0 {
+        let Some(j) = exit_side(u, v) else {
             break;
-        }
+        };
         let Some(q) = neighbour(ds, p, j) else {
             break;
         };

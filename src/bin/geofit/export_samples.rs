@@ -7,7 +7,7 @@ use crate::output::write_exports;
 use geofit::export::{CurveDesc, ExportModel, SurfaceDesc};
 use geofit::geom::Point3;
 use geofit::spline::BSplineCurve;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `geofit export-samples`.
 #[derive(clap::Args)]
@@ -107,6 +107,18 @@ fn surfaces() -> Vec<(&'static str, SurfaceDesc)> {
     vec![("bspline_surface", bspline), ("nurbs_surface", nurbs)]
 }
 
+/// Writes `model` as `<name>.igs` and `<name>.stp` in `dir`; returns the two file names, as
+/// samples.json lists them.
+fn write_iges_and_step(
+    dir: &Path,
+    name: &str,
+    model: &ExportModel,
+) -> Result<(String, String), String> {
+    let (iges, step) = (format!("{name}.igs"), format!("{name}.stp"));
+    write_exports(model, Some(&dir.join(&iges)), Some(&dir.join(&step)))?;
+    Ok((iges, step))
+}
+
 pub fn run(args: Args) -> Result<(), String> {
     std::fs::create_dir_all(&args.dir).map_err(|e| format!("{}: {e}", args.dir.display()))?;
     let mut curve_json = Vec::new();
@@ -115,12 +127,7 @@ pub fn run(args: Args) -> Result<(), String> {
             curves: vec![CurveDesc::from_curve(&curve).map_err(|e| e.to_string())?],
             surfaces: Vec::new(),
         };
-        let (iges, step) = (format!("{name}.igs"), format!("{name}.stp"));
-        write_exports(
-            &model,
-            Some(&args.dir.join(&iges)),
-            Some(&args.dir.join(&step)),
-        )?;
+        let (iges, step) = write_iges_and_step(&args.dir, name, &model)?;
         curve_json.push(serde_json::json!({
             "name": name, "iges": iges, "step": step, "closed": curve.is_closed(),
             "rational": curve.weights().is_some(),
@@ -138,16 +145,11 @@ pub fn run(args: Args) -> Result<(), String> {
                 samples.push([u, v, p.x, p.y, p.z]);
             }
         }
-        let (iges, step) = (format!("{name}.igs"), format!("{name}.stp"));
         let model = ExportModel {
             curves: Vec::new(),
             surfaces: vec![surface],
         };
-        write_exports(
-            &model,
-            Some(&args.dir.join(&iges)),
-            Some(&args.dir.join(&step)),
-        )?;
+        let (iges, step) = write_iges_and_step(&args.dir, name, &model)?;
         surface_json.push(serde_json::json!({
             "name": name, "iges": iges, "step": step, "samples": samples,
         }));

@@ -3,7 +3,7 @@
 //! points of the foot point's span by basis value and normalised per control point, with
 //! acceleration, damping and knot insertion where the error stays above tolerance.
 //!
-use super::{check_degree, curve_state, details, CurveData};
+use super::{check_degree, check_positive, curve_state, details, CurveData};
 use crate::fit::accel::Accelerator;
 use crate::fit::{
     Acceleration, FitError, FitState, FitStatus, Fitter, Method, Shape, Spline, Tolerances,
@@ -66,12 +66,7 @@ impl CurveFitOptions {
     pub fn validate(&self) -> Result<(), FitError> {
         let bad = |name, reason: String| Err(FitError::InvalidOption { name, reason });
         check_degree(self.degree)?;
-        if !(self.simplify_pct.is_finite() && self.simplify_pct > 0.0) {
-            return bad(
-                "simplify_pct",
-                format!("{} must be positive", self.simplify_pct),
-            );
-        }
+        check_positive("simplify_pct", self.simplify_pct)?;
         if self.refine_interval == 0 {
             return bad("refine_interval", "must be at least 1".into());
         }
@@ -80,11 +75,7 @@ impl CurveFitOptions {
     }
 }
 
-impl Default for CurveFitOptions {
-    fn default() -> Self {
-        CurveFitOptions::DEFAULT
-    }
-}
+default_is_const!(CurveFitOptions);
 
 setters!(CurveFitOptions {
     /// Sets the iteration cap.

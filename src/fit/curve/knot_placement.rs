@@ -14,7 +14,7 @@
 //!
 //! Each [`Fitter::step`] is one insertion and one solve.
 
-use super::{check_degree, curve_state, details, least_squares_curve, CurveData};
+use super::{check_degree, check_positive, curve_state, details, least_squares_curve, CurveData};
 use crate::fit::{FitError, FitState, FitStatus, Fitter, Method, Shape, Spline, Tolerances};
 use crate::geom::{Point3, Vec3};
 use crate::spline::BSplineCurve;
@@ -76,12 +76,7 @@ impl KnotPlacementOptions {
     pub fn validate(&self) -> Result<(), FitError> {
         let bad = |name, reason: String| Err(FitError::InvalidOption { name, reason });
         check_degree(self.degree)?;
-        if !(self.curvature_jump.is_finite() && self.curvature_jump > 0.0) {
-            return bad(
-                "curvatureJump",
-                format!("{} must be positive", self.curvature_jump),
-            );
-        }
+        check_positive("curvatureJump", self.curvature_jump)?;
         if !(self.corner_angle_deg > 0.0 && self.corner_angle_deg <= 180.0) {
             return bad(
                 "cornerAngle",
@@ -95,11 +90,7 @@ impl KnotPlacementOptions {
     }
 }
 
-impl Default for KnotPlacementOptions {
-    fn default() -> Self {
-        KnotPlacementOptions::DEFAULT
-    }
-}
+default_is_const!(KnotPlacementOptions);
 
 setters!(KnotPlacementOptions {
     /// Sets the standard-deviation bound, %.

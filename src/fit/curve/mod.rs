@@ -72,6 +72,17 @@ fn check_degree(degree: usize) -> Result<(), FitError> {
     })
 }
 
+/// Fails unless `value` is finite and positive; both curve fitters word it the same.
+fn check_positive(name: &'static str, value: f64) -> Result<(), FitError> {
+    if value.is_finite() && value > 0.0 {
+        return Ok(());
+    }
+    Err(FitError::InvalidOption {
+        name,
+        reason: format!("{value} must be positive"),
+    })
+}
+
 /// The scheme a curve of `degree` is fitted as: Chaikin's corner cutting converges to the
 /// quadratic B-spline.
 fn scheme_of(degree: usize) -> Scheme {

@@ -161,11 +161,7 @@ impl SubdivFitOptions {
     }
 }
 
-impl Default for SubdivFitOptions {
-    fn default() -> Self {
-        SubdivFitOptions::DEFAULT
-    }
-}
+default_is_const!(SubdivFitOptions);
 
 setters!(SubdivFitOptions {
     /// Sets the stopping tolerances.

@@ -76,14 +76,6 @@ impl GeometricSurfaceOptions {
         &mut self.grid
     }
 
-    /// Sets when a knot vector is split early: after `iterations` while more than `share` of
-    /// the patches fail.
-    pub fn with_early_split(mut self, iterations: usize, share: f64) -> Self {
-        self.early_split_after = iterations;
-        self.early_split_share = share;
-        self
-    }
-
     /// Checks every option's range.
     pub fn validate(&self) -> Result<(), FitError> {
         self.grid.validate()?;
@@ -92,17 +84,14 @@ impl GeometricSurfaceOptions {
     }
 }
 
-impl Default for GeometricSurfaceOptions {
-    fn default() -> Self {
-        GeometricSurfaceOptions::DEFAULT
-    }
-}
+default_is_const!(GeometricSurfaceOptions);
 
 setters!(GeometricSurfaceOptions {
+    /// Sets when a knot vector is split early: after `iterations` while more than `share` of
+    /// the patches fail.
+    with_early_split(iterations: usize, share: f64) => |s| s.early_split_after, s.early_split_share;
     /// Sets the acceleration.
     with_acceleration(acceleration: Acceleration) => |s| s.acceleration;
-    /// Sets the iteration cap.
-    with_max_iterations(max_iterations: usize) => |s| s.max_iterations;
     /// Starts from a least-squares solve (true) or from the flat control net (false).
     with_warm_start(warm_start: bool) => |s| s.warm_start;
 });

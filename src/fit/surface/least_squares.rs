@@ -77,13 +77,6 @@ impl LsqSurfaceOptions {
         &mut self.grid
     }
 
-    /// Sets β2 and β3.
-    pub fn with_betas(mut self, beta2: f64, beta3: f64) -> Self {
-        self.beta2 = beta2;
-        self.beta3 = beta3;
-        self
-    }
-
     /// Checks every option's range.
     pub fn validate(&self) -> Result<(), FitError> {
         self.grid.validate()?;
@@ -106,19 +99,15 @@ impl LsqSurfaceOptions {
     }
 }
 
-impl Default for LsqSurfaceOptions {
-    fn default() -> Self {
-        LsqSurfaceOptions::DEFAULT
-    }
-}
+default_is_const!(LsqSurfaceOptions);
 
 setters!(LsqSurfaceOptions {
+    /// Sets β2 and β3.
+    with_betas(beta2: f64, beta3: f64) => |s| s.beta2, s.beta3;
     /// Sets the number of solves per knot vector.
     with_solves_per_knots(solves_per_knots: usize) => |s| s.solves_per_knots;
     /// Sets the failing share of patches above which a knot vector is split after one solve.
     with_early_split_share(early_split_share: f64) => |s| s.early_split_share;
-    /// Sets the iteration cap.
-    with_max_iterations(max_iterations: usize) => |s| s.max_iterations;
 });
 
 /// Smoothed least-squares B-spline surface fitter (SPEC §2), driven through [`Fitter`].

@@ -234,11 +234,7 @@ impl SurfaceGrid {
     }
 }
 
-impl Default for SurfaceGrid {
-    fn default() -> Self {
-        SurfaceGrid::DEFAULT
-    }
-}
+default_is_const!(SurfaceGrid);
 
 setters!([SurfaceGrid, GeometricSurfaceOptions, LsqSurfaceOptions] {
     /// Sets the degree.
@@ -251,6 +247,11 @@ setters!([SurfaceGrid, GeometricSurfaceOptions, LsqSurfaceOptions] {
     with_min_sample(min_sample: usize) => |s| s.grid_mut().min_sample;
     /// Sets the parameterisation options.
     with_param(param: ParamOptions) => |s| s.grid_mut().param;
+});
+
+setters!([GeometricSurfaceOptions, LsqSurfaceOptions] {
+    /// Sets the iteration cap.
+    with_max_iterations(max_iterations: usize) => |s| s.max_iterations;
 });
 
 /// The setters that take two values, for every options type holding a [`SurfaceGrid`].

@@ -45,11 +45,7 @@ pub struct ParamOptions {
     pub min_area: bool,
 }
 
-impl Default for ParamOptions {
-    fn default() -> Self {
-        ParamOptions::DEFAULT
-    }
-}
+default_is_const!(ParamOptions);
 
 impl ParamOptions {
     /// The defaults, as each field documents them.

@@ -167,38 +167,45 @@ macro_rules! decode {
     }};
 }
 
-impl<const BIG: bool> Body for Binary<'_, BIG> {
-    fn value(&mut self, t: Scalar) -> Result<f64, Fault> {
-        Ok(match t {
-            Scalar::I8 => f64::from(decode!(self, i8, 1)),
-            Scalar::U8 => f64::from(decode!(self, u8, 1)),
-            Scalar::I16 => f64::from(decode!(self, i16, 2)),
-            Scalar::U16 => f64::from(decode!(self, u16, 2)),
-            Scalar::I32 => f64::from(decode!(self, i32, 4)),
-            Scalar::U32 => f64::from(decode!(self, u32, 4)),
-            Scalar::F32 => f64::from(decode!(self, f32, 4)),
-            Scalar::F64 => decode!(self, f64, 8),
-        })
-    }
-
-    fn integer(&mut self, t: Scalar) -> Result<i64, Fault> {
-        Ok(match t {
+impl<const BIG: bool> Binary<'_, BIG> {
+    /// Decodes a value of an integer type; `None` (nothing read) for the float types. Both
+    /// `value` and `integer` read the integer types alike.
+    fn whole(&mut self, t: Scalar) -> Result<Option<i64>, Fault> {
+        Ok(Some(match t {
             Scalar::I8 => i64::from(decode!(self, i8, 1)),
             Scalar::U8 => i64::from(decode!(self, u8, 1)),
             Scalar::I16 => i64::from(decode!(self, i16, 2)),
             Scalar::U16 => i64::from(decode!(self, u16, 2)),
             Scalar::I32 => i64::from(decode!(self, i32, 4)),
             Scalar::U32 => i64::from(decode!(self, u32, 4)),
-            Scalar::F32 | Scalar::F64 => {
-                let v = self.value(t)?;
-                // Float-typed indices are whole numbers well inside i64 or they are wrong.
-                if v.fract() == 0.0 && v.abs() < 9.0e15 {
-                    v as i64
-                } else {
-                    return Err(Fault::NotInteger(v.to_string()));
-                }
-            }
+            Scalar::F32 | Scalar::F64 => return Ok(None),
+        }))
+    }
+}
+
+impl<const BIG: bool> Body for Binary<'_, BIG> {
+    fn value(&mut self, t: Scalar) -> Result<f64, Fault> {
+        if let Some(n) = self.whole(t)? {
+            // PLY's integer types are at most 32 bits: an f64 holds them exactly.
+            return Ok(n as f64);
+        }
+        Ok(match t {
+            Scalar::F32 => f64::from(decode!(self, f32, 4)),
+            _ => decode!(self, f64, 8),
         })
+    }
+
+    fn integer(&mut self, t: Scalar) -> Result<i64, Fault> {
+        if let Some(n) = self.whole(t)? {
+            return Ok(n);
+        }
+        let v = self.value(t)?;
+        // Float-typed indices are whole numbers well inside i64 or they are wrong.
+        if v.fract() == 0.0 && v.abs() < 9.0e15 {
+            Ok(v as i64)
+        } else {
+            Err(Fault::NotInteger(v.to_string()))
+        }
     }
 
     fn skip(&mut self, t: Scalar, n: usize) -> Result<(), Fault> {

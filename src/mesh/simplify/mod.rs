@@ -99,31 +99,18 @@ impl Default for SimplifyOptions {
     }
 }
 
-impl SimplifyOptions {
+setters!(SimplifyOptions {
     /// Sets [`SimplifyOptions::boundary_weight`].
-    pub fn with_boundary_weight(mut self, weight: f64) -> SimplifyOptions {
-        self.boundary_weight = weight;
-        self
-    }
-
+    with_boundary_weight(weight: f64) => |s| s.boundary_weight;
     /// Sets [`SimplifyOptions::max_normal_change_deg`].
-    pub fn with_max_normal_change_deg(mut self, degrees: f64) -> SimplifyOptions {
-        self.max_normal_change_deg = degrees;
-        self
-    }
-
+    with_max_normal_change_deg(degrees: f64) => |s| s.max_normal_change_deg;
     /// Sets [`SimplifyOptions::min_triangle_quality`].
-    pub fn with_min_triangle_quality(mut self, quality: f64) -> SimplifyOptions {
-        self.min_triangle_quality = quality;
-        self
-    }
-
+    with_min_triangle_quality(quality: f64) => |s| s.min_triangle_quality;
     /// Sets [`SimplifyOptions::max_valence`].
-    pub fn with_max_valence(mut self, valence: usize) -> SimplifyOptions {
-        self.max_valence = valence;
-        self
-    }
+    with_max_valence(valence: usize) => |s| s.max_valence;
+});
 
+impl SimplifyOptions {
     fn validate(&self) -> Result<(), SimplifyError> {
         let check = |name, value: f64, ok: bool, expected| {
             if ok {
