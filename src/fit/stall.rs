@@ -52,7 +52,14 @@ pub(crate) fn stalled(
         if !(now > tol && old.is_finite()) {
             return false;
         }
-        let ratio = now / old;
+        // A statistic whose latest value is the best of a window it has been falling through
+        // is progressing, whatever an earlier window held: its rate is that fall.
+        let values: Vec<f64> = last.iter().filter_map(value).collect();
+        let falling = match (values.first(), values.last()) {
+            (Some(&first), Some(&latest)) if latest <= now && first > 0.0 => latest / first,
+            _ => 1.0,
+        };
+        let ratio = (now / old).min(falling);
         if ratio > 1.0 - MIN_GAIN {
             return true;
         }
@@ -110,6 +117,21 @@ mod tests {
             r.e_back_max_pct = Some(if r.iter == 1 { 0.6 } else { 1.17 });
         }
         assert!(stalled(&h, &tol(0.5), 100));
+    }
+
+    #[test]
+    fn a_statistic_falling_through_the_window_is_not_stalled() {
+        // E_back rose after a refinement (0.79 before it), then falls from 1.41 to 1.0016
+        // (teapot at 0.1 / 0.5): one more iteration meets the bound of 1.0.
+        let mut h: Vec<_> = (1..=21).map(|i| record(i, 0.01)).collect();
+        for r in &mut h {
+            r.e_back_max_pct = Some(if r.iter <= 11 {
+                0.79
+            } else {
+                1.41 - 0.0409 * (r.iter - 11) as f64
+            });
+        }
+        assert!(!stalled(&h, &tol(0.5), 100));
     }
 
     #[test]
