@@ -101,23 +101,24 @@ fn bad_options_fail_with_a_message() {
     }
 }
 
-/// The page's first sample with its preset (www/samples/samples.json) converges both ways in
-/// every subdivision scheme: data → surface within the tolerances and no surface sample farther
-/// from the data than the surface → data bound (a blister between the sample's sparse points
-/// once made Loop and Doo–Sabin stall, and the page's Play never reach "converged").
+/// The page's first sample with the defaults (its preset sets only the scheme,
+/// www/samples/samples.json) converges both ways in every subdivision scheme: data → surface
+/// within the tolerances and no surface sample farther from the data than the surface → data
+/// bound (a blister between the sample's sparse points once made Loop and Doo–Sabin stall,
+/// and the page's Play never reach "converged").
 #[test]
-fn the_page_sample_converges_both_ways_with_its_preset() {
+fn the_page_sample_converges_both_ways_with_the_defaults() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/samples");
     let samples: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(root.join("samples.json")).expect("list"))
             .expect("JSON");
     let first = &samples["samples"][0];
-    let preset = &first["preset"];
+    let preset = first["preset"].as_object().expect("preset");
+    assert_eq!(preset.keys().collect::<Vec<_>>(), ["scheme"]);
     let file = root.join(first["file"].as_str().expect("file name"));
-    let (tol_avg, tol_max) = (
-        preset["tolAvg"].as_f64().expect("tolAvg"),
-        preset["tolMax"].as_f64().expect("tolMax"),
-    );
+    let tol_max = geofit::fit::SubdivFitOptions::DEFAULT_TOLERANCES
+        .max_pct
+        .expect("an E_max tolerance");
     let json = std::env::temp_dir().join(format!("geofit-sample-{}.json", std::process::id()));
     for scheme in ["loop", "catmull-clark", "doo-sabin"] {
         common::run_ok(Command::new(env!("CARGO_BIN_EXE_geofit")).args([
@@ -125,12 +126,6 @@ fn the_page_sample_converges_both_ways_with_its_preset() {
             file.to_str().expect("utf-8"),
             "--scheme",
             scheme,
-            "--tol-avg",
-            &tol_avg.to_string(),
-            "--tol-max",
-            &tol_max.to_string(),
-            "--initial",
-            &preset["initial"].to_string(),
             "-q",
             "--json",
             json.to_str().expect("utf-8"),

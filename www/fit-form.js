@@ -27,9 +27,17 @@ export class FitForm {
     // Fields the user (or a sample's preset) set: a change of scheme keeps them.
     /** @type {Set<string>} */
     this.edited = new Set();
+    // Of those, the ones a preset set and the user has not touched since: the next file
+    // (a dropped one has no preset) gets the core's defaults there again.
+    /** @type {Set<string>} */
+    this.preset = new Set();
     for (const control of this.controls()) {
-      control.addEventListener('input', () => this.edited.add(control.name));
+      control.addEventListener('input', () => {
+        this.edited.add(control.name);
+        this.preset.delete(control.name);
+      });
     }
+    this.scheme.addEventListener('input', () => this.preset.delete('scheme'));
     this.schemeChanged();
   }
 
@@ -83,17 +91,25 @@ export class FitForm {
   }
 
   /**
-   * Sets fields from a sample's preset (an options object), as if the user had; other fields
-   * keep what the user set.
+   * Sets fields from a file's preset (a bundled sample's options object; `{}` for a file of
+   * the user's), as if the user had. What an earlier preset set and the user left alone goes
+   * back to the core's default (the scheme to the page's first); what the user set stays.
    * @param {Object<string, unknown>} preset
    */
   apply(preset) {
-    if (typeof preset.scheme === 'string') this.scheme.value = preset.scheme;
+    for (const name of this.preset) this.edited.delete(name);
+    if (this.preset.has('scheme')) this.scheme.value = this.scheme.options[0].value;
+    this.preset.clear();
+    if (typeof preset.scheme === 'string') {
+      this.scheme.value = preset.scheme;
+      this.preset.add('scheme');
+    }
     this.schemeChanged();
     for (const control of this.controls()) {
       if (control.name in preset) {
         setValue(control, preset[control.name]);
         this.edited.add(control.name);
+        this.preset.add(control.name);
       }
     }
   }

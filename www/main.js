@@ -22,6 +22,8 @@ const ui = {
   fileName: el('file-name'),
   points: el('num-points'),
   triangles: el('num-triangles'),
+  straysRow: el('strays-row'),
+  strays: el('strays'),
   backend: el('backend'),
   showPoints: el('show-points'),
   showMesh: el('show-mesh'),
@@ -88,8 +90,11 @@ function diagonal(scan) {
   return lo.length === 3 ? Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) : 0;
 }
 
-/** Parses `bytes` with the Rust readers and shows the result; on error keeps what was shown. */
-function show(bytes, name) {
+/**
+ * Parses `bytes` with the Rust readers and shows the result; on error keeps what was shown.
+ * `preset`: the fit options of a bundled sample (a user's file has none: the core's defaults).
+ */
+function show(bytes, name, preset = {}) {
   let scan;
   try {
     scan = loadFile(bytes, name);
@@ -112,10 +117,11 @@ function show(bytes, name) {
     ui.fileName.textContent = name;
     ui.points.textContent = scan.numPoints.toLocaleString('en-US');
     ui.triangles.textContent = scan.numTriangles.toLocaleString('en-US');
+    showStrays(scan.strays());
     clearError();
     setState('ready');
     requestRender();
-    fitUi?.onScan(bytes, name, diagonal(scan), samplePresets[name]);
+    fitUi?.onScan(bytes, name, diagonal(scan), preset);
     return true;
   } catch (e) {
     showError(`Could not show ${name}: ${e?.message ?? e}`);
@@ -124,6 +130,13 @@ function show(bytes, name) {
   } finally {
     scan.free();
   }
+}
+
+/** Lists the points left out as strays (the view and the fit leave them out), if any. */
+function showStrays(strays) {
+  const shown = [...strays.slice(0, 5)].join(', ') + (strays.length > 5 ? ', …' : '');
+  ui.strays.textContent = `${strays.length.toLocaleString('en-US')} (point${strays.length > 1 ? 's' : ''} ${shown})`;
+  ui.straysRow.hidden = strays.length === 0;
 }
 
 async function openFile(file) {
@@ -285,7 +298,7 @@ async function openSample(name) {
     setState('error');
     return;
   }
-  show(new Uint8Array(await response.arrayBuffer()), name);
+  show(new Uint8Array(await response.arrayBuffer()), name, samplePresets[name]);
 }
 
 main().catch((e) => {

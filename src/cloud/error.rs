@@ -18,6 +18,14 @@ pub enum ReconstructError {
         /// Index of the offending point.
         index: usize,
     },
+    /// A coordinate is beyond ±[`COORDINATE_LIMIT`](crate::geom::COORDINATE_LIMIT).
+    #[error("point {index} has coordinate {value:e}, beyond ±3.4e38 (the largest an f32 holds)")]
+    CoordinateOutOfRange {
+        /// Index of the offending point.
+        index: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// The points do not span a surface: they coincide or lie on one line.
     #[error("the points are {what}: they span no surface")]
     Degenerate {
@@ -45,4 +53,17 @@ pub enum ReconstructError {
     /// Nothing usable was left: every triangle was removed as spanning a gap.
     #[error("no triangles were left after removing long edges and non-manifold pieces")]
     NoSurface,
+}
+
+impl From<crate::geom::BadCoordinate> for ReconstructError {
+    fn from(bad: crate::geom::BadCoordinate) -> ReconstructError {
+        match bad {
+            crate::geom::BadCoordinate::NonFinite { index } => {
+                ReconstructError::NonFinitePoint { index }
+            }
+            crate::geom::BadCoordinate::OutOfRange { index, value } => {
+                ReconstructError::CoordinateOutOfRange { index, value }
+            }
+        }
+    }
 }

@@ -168,9 +168,7 @@ pub fn reconstruct(
     options: &ReconstructOptions,
 ) -> Result<Reconstruction, ReconstructError> {
     options.validate()?;
-    if let Some(index) = points.iter().position(|p| !p.is_finite()) {
-        return Err(ReconstructError::NonFinitePoint { index });
-    }
+    crate::geom::check_coordinates(points)?;
     if points.len() < MIN_POINTS {
         return Err(ReconstructError::TooFewPoints {
             count: points.len(),

@@ -136,6 +136,24 @@ pub enum FitError {
         /// Index of the point in the data.
         index: usize,
     },
+    /// A data point has a coordinate beyond ±[`COORDINATE_LIMIT`](crate::geom::COORDINATE_LIMIT).
+    ///
+    /// ```
+    /// use geofit::fit::{CurveFitOptions, CurveFitter, FitError};
+    /// use geofit::geom::Point3;
+    /// let pts = [Point3::ZERO, Point3::X, Point3::new(0.0, 1e300, 0.0), Point3::Y];
+    /// let err = CurveFitter::try_new(&pts, CurveFitOptions::default()).err();
+    /// assert_eq!(err, Some(FitError::CoordinateOutOfRange { index: 2, value: 1e300 }));
+    /// ```
+    #[error(
+        "data point {index} has coordinate {value:e}, beyond ±3.4e38 (the largest an f32 holds)"
+    )]
+    CoordinateOutOfRange {
+        /// Index of the point in the data.
+        index: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// A data point repeats the one before it, so the polyline has a zero-length segment.
     ///
     /// ```
@@ -265,4 +283,15 @@ pub enum FitError {
         /// The check that failed.
         what: String,
     },
+}
+
+impl From<crate::geom::BadCoordinate> for FitError {
+    fn from(bad: crate::geom::BadCoordinate) -> FitError {
+        match bad {
+            crate::geom::BadCoordinate::NonFinite { index } => FitError::NonFinitePoint { index },
+            crate::geom::BadCoordinate::OutOfRange { index, value } => {
+                FitError::CoordinateOutOfRange { index, value }
+            }
+        }
+    }
 }

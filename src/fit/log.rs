@@ -2,7 +2,7 @@
 //! and what happened to the data on intake.
 
 use super::reference::BackStats;
-use super::{ErrorStats, FitStatus, IterationRecord, ReconstructionReport};
+use super::{ErrorStats, FitStatus, IterationRecord, ReconstructionReport, StrayPoints};
 use crate::mesh::SimplifyReport;
 use web_time::Instant;
 
@@ -16,6 +16,7 @@ pub struct FitLog {
     fit_s: f64,
     reconstruction: Option<ReconstructionReport>,
     simplification: Option<SimplifyReport>,
+    strays: Option<StrayPoints>,
 }
 
 impl FitLog {
@@ -29,6 +30,7 @@ impl FitLog {
             fit_s: 0.0,
             reconstruction: None,
             simplification: None,
+            strays: None,
         }
     }
 
@@ -123,11 +125,22 @@ impl FitLog {
         self.simplification = report;
     }
 
+    /// The data points left out as strays, when there were any.
+    pub fn strays(&self) -> Option<&StrayPoints> {
+        self.strays.as_ref()
+    }
+
+    /// Records the data points left out as strays.
+    pub(crate) fn set_strays(&mut self, strays: Option<StrayPoints>) {
+        self.strays = strays;
+    }
+
     /// What happened to the data before the first iteration, one line each for people (the
-    /// CLI prints them, the page shows them): the reconstruction of bare points, the repair of
+    /// CLI prints them, the page shows them): the strays left out, the reconstruction of bare
+    /// points, the repair of
     /// the mesh, and a simplification that relaxed its guards or stopped above its target.
     pub fn intake_notes(&self) -> Vec<String> {
-        let mut notes = Vec::new();
+        let mut notes: Vec<String> = self.strays.iter().map(StrayPoints::note).collect();
         if let Some(r) = &self.reconstruction {
             notes.push(format!(
                 "reconstructed {} surface ({}): {} triangles, {} outliers removed",

@@ -25,6 +25,7 @@ mod spec;
 mod stall;
 mod state;
 mod stats;
+mod strays;
 mod subdiv;
 mod surface;
 
@@ -40,6 +41,7 @@ pub use report::{within_tolerance_pct, FitReport};
 pub use spec::{Cloud, FitData, FitSpec, Method, OptionInfo, Scheme, OPTION_TABLE};
 pub use state::{FitState, BACK_TOLERANCE_FACTOR};
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
+pub use strays::StrayPoints;
 pub use subdiv::{
     default_initial_count, initial_control, surface_of, ControlSurface, ReconstructionReport,
     SubdivFitOptions, SubdivFitter, Weighting,

@@ -72,7 +72,8 @@ impl BackStats {
 /// triangle's flatness; more is a crease, which a smooth surface rounds off for real.
 const MAX_TURN: f64 = std::f64::consts::FRAC_PI_6;
 
-/// One data triangle in the R-tree: its corners (f32, compact storage), which of its edges
+/// One data triangle in the R-tree: its corners (f32, compact storage, relative to
+/// [`DataSurface::origin`]), which of its edges
 /// and corners lie on the data's boundary (bit k: edge from corner k to corner k + 1; bit 3 + k:
 /// corner k), and its [`sagitta`].
 struct Triangle {
@@ -129,6 +130,10 @@ impl PointDistance for Rim {
 
 /// The data's triangles, indexed for nearest-point queries.
 pub struct DataSurface {
+    /// The centre of the data's bounding box. Everything below is stored and queried relative
+    /// to it: f32 corners of a scan in survey coordinates (UTM, millions of metres from the
+    /// origin) would otherwise be rounded to a quarter of a metre.
+    origin: Point3,
     tree: RTree<Triangle>,
     /// The boundary edges (none on a closed mesh).
     rim: RTree<Rim>,
@@ -163,11 +168,9 @@ impl DataSurface {
         if triangles.is_empty() {
             return None;
         }
-        let positions: Vec<[f32; 3]> = mesh
-            .positions()
-            .iter()
-            .map(|p| [p.x as f32, p.y as f32, p.z as f32])
-            .collect();
+        let origin = mesh.bbox()?.center();
+        let local: Vec<Point3> = mesh.positions().iter().map(|&p| p - origin).collect();
+        let positions: Vec<[f32; 3]> = local.iter().map(|p| p.as_vec3().to_array()).collect();
         let boundary = boundary_edges(&triangles);
         let mut on_boundary = vec![false; positions.len()];
         for (t, &b) in triangles.iter().zip(&boundary) {
@@ -182,7 +185,7 @@ impl DataSurface {
         for (t, &b) in triangles.iter().zip(&boundary) {
             for k in 0..3 {
                 if b & (1 << k) != 0 {
-                    let at = |i: u32| mesh.positions()[i as usize].to_array();
+                    let at = |i: u32| local[i as usize].to_array();
                     rim.push(Rim([at(t[k]), at(t[(k + 1) % 3])]));
                 }
             }
@@ -224,6 +227,7 @@ impl DataSurface {
             })
             .collect();
         Some(DataSurface {
+            origin,
             tree: RTree::bulk_load(objects),
             rim: RTree::bulk_load(rim),
             loose: (!loose.is_empty()).then(|| ImmutableKdTree::new_from_slice(&loose)),
@@ -235,6 +239,7 @@ impl DataSurface {
     /// nearest to it, or `None` when `p`'s nearest data point is on the data's boundary (over a
     /// hole, or beyond the outline).
     pub fn distance(&self, p: Point3) -> Option<f64> {
+        let p = p - self.origin;
         let foot = self.nearest(p)?;
         let loose = self.loose.as_ref().map_or(f64::INFINITY, |t| {
             let q = [p.x as f32, p.y as f32, p.z as f32];
@@ -271,7 +276,8 @@ impl DataSurface {
         BackStats::of(&self.distances(samples), diagonal)
     }
 
-    /// The nearest point of the data surface, and whether it lies on the data's boundary.
+    /// The nearest point of the data surface to `p` (relative to the origin), and whether it
+    /// lies on the data's boundary.
     fn nearest(&self, p: Point3) -> Option<Foot> {
         if !p.is_finite() {
             return None;

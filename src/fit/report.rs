@@ -1,7 +1,7 @@
 //! The machine-readable summary of a fit (`geofit fit --json`, `Fitter.reportJson()`): one
 //! builder, [`FitReport::of`], for every engine.
 
-use super::{FitStatus, Fitter, IterationRecord, ReconstructionReport};
+use super::{FitStatus, Fitter, IterationRecord, ReconstructionReport, StrayPoints};
 use crate::mesh::SimplifyReport;
 use serde::Serialize;
 
@@ -40,6 +40,9 @@ pub struct FitReport {
     /// changed (`simplification.repair`); absent when a control mesh was given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simplification: Option<SimplifyReport>,
+    /// The data points left out as strays (absent when there were none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub strays: Option<StrayPoints>,
     /// What happened to the data before the first iteration, for people
     /// ([`FitLog::intake_notes`](super::FitLog::intake_notes)).
     pub intake: Vec<String>,
@@ -82,6 +85,7 @@ impl FitReport {
                 .map(|tol| within_tolerance_pct(fitter.point_errors(), fitter.diagonal(), tol)),
             reconstruction: log.reconstruction().cloned(),
             simplification: log.simplification().cloned(),
+            strays: log.strays().cloned(),
             intake: log.intake_notes(),
             precompute_s,
             fit_s,

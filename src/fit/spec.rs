@@ -25,6 +25,7 @@
 //! ```
 
 use super::curve::{CurveFitOptions, CurveFitter, KnotPlacementFitter, KnotPlacementOptions};
+use super::strays::WithoutStrays;
 use super::subdiv::{build_subdiv_fitter, SubdivFitOptions, Weighting};
 use super::surface::{
     FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter,
@@ -674,13 +675,17 @@ impl FitSpec {
         }
     }
 
-    /// Builds the engine for `data`: validates, makes the initial control net (QEM
+    /// Builds the engine for `data`: validates, leaves out stray points far from the rest
+    /// ([`crate::geom::find_strays`]; the log's [`FitLog::strays`](super::FitLog::strays)
+    /// lists them), makes the initial control net (QEM
     /// simplification, with meshing of bare points first, for subdivision; the projection
     /// grid for surfaces; Douglas–Peucker for curves) and the first foot points. The log's
     /// set-up time covers all of it.
     pub fn build(&self, data: &FitData) -> Result<Box<dyn Fitter>, FitError> {
         let start = Instant::now();
         self.validate()?;
+        let without_strays = WithoutStrays::of(data);
+        let data = &without_strays.as_ref().map_or(*data, |w| w.data(data));
         let points = data.mesh.positions();
         let mut fitter: Box<dyn Fitter> = match (self.scheme, self.method()) {
             (scheme, _) if scheme.subdivision().is_some() => {
@@ -716,6 +721,9 @@ impl FitSpec {
         let own = fitter.log().precompute_seconds();
         let outside = start.elapsed().as_secs_f64() - own;
         fitter.log_mut().add_precompute(outside);
+        fitter
+            .log_mut()
+            .set_strays(without_strays.map(|w| w.strays));
         Ok(fitter)
     }
 

@@ -2,10 +2,12 @@
 //! query every shape answers.
 
 mod aabb;
+mod coords;
 mod eigen;
 mod nearest;
 
 pub use aabb::Aabb;
+pub use coords::{check_coordinates, find_strays, BadCoordinate, COORDINATE_LIMIT};
 pub use eigen::symmetric_eigen;
 pub use nearest::{ClosestPoint, Nearest, NewtonOptions};
 

@@ -58,6 +58,20 @@ impl RangeGrid {
 }
 
 impl RangeGrid {
+    /// The grid over the points renumbered by `new_index` (the new index of every old point,
+    /// [`crate::mesh::NONE`] for one left out, whose cell becomes empty).
+    pub fn renumbered(&self, new_index: &[u32]) -> RangeGrid {
+        let cells = self
+            .cells
+            .iter()
+            .map(|c| {
+                c.and_then(|i| new_index.get(i as usize).copied())
+                    .filter(|&i| i != crate::mesh::NONE)
+            })
+            .collect();
+        RangeGrid { cells, ..*self }
+    }
+
     /// The scan's sample spacing: the median distance between measured cells that are
     /// neighbours along a row or a column. `None` when no two neighbours were measured (or
     /// `positions` is not the scan's point list). The natural unit for

@@ -10,6 +10,17 @@ pub enum MeshError {
         /// Index of the offending vertex.
         vertex: usize,
     },
+    /// A vertex coordinate is finite but beyond ±[`COORDINATE_LIMIT`](crate::geom::COORDINATE_LIMIT).
+    #[error(
+        "vertex {vertex} has coordinate {value:e}, beyond ±3.4e38 (the largest an f32 holds; \
+         geofit renders and stores positions as f32)"
+    )]
+    CoordinateOutOfRange {
+        /// Index of the offending vertex.
+        vertex: usize,
+        /// The coordinate.
+        value: f64,
+    },
     /// A face refers to a vertex that does not exist.
     #[error("face {face} refers to vertex {index}, but the mesh has {vertex_count} vertices")]
     IndexOutOfRange {
@@ -34,4 +45,20 @@ pub enum MeshError {
         /// What overflowed.
         what: &'static str,
     },
+}
+
+impl From<crate::geom::BadCoordinate> for MeshError {
+    fn from(bad: crate::geom::BadCoordinate) -> MeshError {
+        match bad {
+            crate::geom::BadCoordinate::NonFinite { index } => {
+                MeshError::NonFiniteVertex { vertex: index }
+            }
+            crate::geom::BadCoordinate::OutOfRange { index, value } => {
+                MeshError::CoordinateOutOfRange {
+                    vertex: index,
+                    value,
+                }
+            }
+        }
+    }
 }

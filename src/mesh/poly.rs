@@ -1,9 +1,10 @@
 use super::MeshError;
-use crate::geom::{Aabb, Point3};
+use crate::geom::{check_coordinates, Aabb, Point3};
 
 /// Points with optional polygon connectivity: what every reader produces and every writer takes.
 ///
-/// Invariants, checked by [`PolyMesh::try_new`]: every coordinate is finite, every face has at
+/// Invariants, checked by [`PolyMesh::try_new`]: every coordinate is finite and within
+/// ±[`COORDINATE_LIMIT`](crate::geom::COORDINATE_LIMIT), every face has at
 /// least three vertices, and every face index is in range. Vertices that belong to no face are
 /// allowed (scans have them, and they are data points all the same).
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -21,9 +22,7 @@ impl PolyMesh {
         F: IntoIterator<Item = I>,
         I: AsRef<[u32]>,
     {
-        if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(MeshError::NonFiniteVertex { vertex });
-        }
+        check_coordinates(&positions)?;
         if u32::try_from(positions.len()).is_err() {
             return Err(MeshError::TooLarge {
                 what: "vertex count",
@@ -69,6 +68,36 @@ impl PolyMesh {
     /// Points only, no faces.
     pub fn from_points(positions: Vec<Point3>) -> Result<PolyMesh, MeshError> {
         PolyMesh::try_new(positions, std::iter::empty::<[u32; 3]>())
+    }
+
+    /// The mesh without the vertices `drop` (sorted indices) and the faces that use them, and
+    /// the new index of every old vertex ([`crate::mesh::NONE`] for a dropped one). Vertices
+    /// keep their order.
+    pub fn without_vertices(&self, drop: &[u32]) -> (PolyMesh, Vec<u32>) {
+        let mut new_index = vec![0; self.num_vertices()];
+        for &v in drop {
+            new_index[v as usize] = super::NONE;
+        }
+        let mut positions = Vec::with_capacity(self.num_vertices() - drop.len());
+        for (v, slot) in new_index.iter_mut().enumerate() {
+            if *slot != super::NONE {
+                *slot = positions.len() as u32;
+                positions.push(self.positions[v]);
+            }
+        }
+        let mut mesh = PolyMesh {
+            positions,
+            face_starts: vec![0],
+            face_indices: Vec::new(),
+        };
+        for f in self.faces() {
+            if f.iter().all(|&v| new_index[v as usize] != super::NONE) {
+                mesh.face_indices
+                    .extend(f.iter().map(|&v| new_index[v as usize]));
+                mesh.face_starts.push(mesh.face_indices.len() as u32);
+            }
+        }
+        (mesh, new_index)
     }
 
     fn push_face(&mut self, face: usize, f: &[u32]) -> Result<(), MeshError> {
@@ -176,5 +205,24 @@ mod tests {
         assert!(matches!(e, MeshError::FaceTooSmall { face: 0, len: 2 }));
         let e = PolyMesh::from_points(vec![p(0.0), p(f64::NAN)]).unwrap_err();
         assert!(matches!(e, MeshError::NonFiniteVertex { vertex: 1 }));
+        let e = PolyMesh::from_points(vec![p(0.0), p(1.0), p(-1e308)]).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "vertex 2 has coordinate -1e308, beyond ±3.4e38 (the largest an f32 holds; geofit \
+             renders and stores positions as f32)"
+        );
+    }
+
+    #[test]
+    fn dropping_vertices_drops_their_faces_and_renumbers_the_rest() {
+        let m = PolyMesh::try_new(
+            vec![p(0.0), p(1.0), p(2.0), p(3.0), p(4.0)],
+            [vec![0, 1, 2], vec![1, 3, 4], vec![2, 3, 4, 0]],
+        )
+        .unwrap();
+        let (kept, new_index) = m.without_vertices(&[1]);
+        assert_eq!(new_index, vec![0, crate::mesh::NONE, 1, 2, 3]);
+        assert_eq!(kept.positions(), &[p(0.0), p(2.0), p(3.0), p(4.0)]);
+        assert_eq!(kept.faces().collect::<Vec<_>>(), vec![&[1u32, 2, 3, 0][..]]);
     }
 }

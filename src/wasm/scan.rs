@@ -1,13 +1,21 @@
 //! `loadFile` and the `LoadedScan` handle: a parsed point or mesh file, ready to draw.
 
+use crate::geom::find_strays;
 use crate::io::{self, LoadedFile};
+use crate::mesh::PolyMesh;
 use crate::render::buffers;
 use wasm_bindgen::prelude::*;
 
-/// A point or mesh file read by the core: its counts, bounding box and draw buffers.
+/// A point or mesh file read by the core: its counts, bounding box and draw buffers. Points far
+/// from the rest ([`crate::geom::find_strays`]), which a fit leaves out, are left out of the
+/// bounding box and the draw buffers too, so that the view frames the object; `strays` lists
+/// them.
 #[wasm_bindgen]
 pub struct LoadedScan {
     file: LoadedFile,
+    strays: Vec<u32>,
+    /// The file's mesh without its strays, when it has any.
+    kept: Option<PolyMesh>,
 }
 
 /// Reads a point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS) from its bytes. `name` is the file
@@ -15,13 +23,20 @@ pub struct LoadedScan {
 #[wasm_bindgen(js_name = loadFile)]
 pub fn load_file(bytes: &[u8], name: &str) -> Result<LoadedScan, JsError> {
     let file = io::read_bytes(bytes, Some(name))?;
-    Ok(LoadedScan { file })
+    let strays = find_strays(file.mesh.positions());
+    let kept = (!strays.is_empty()).then(|| file.mesh.without_vertices(&strays).0);
+    Ok(LoadedScan { file, strays, kept })
 }
 
 impl LoadedScan {
     /// What a fit of this file runs on.
     pub(crate) fn fit_data(&self) -> crate::fit::FitData<'_> {
         crate::fit::FitData::from(&self.file)
+    }
+
+    /// The points drawn and framed: the file's, strays left out.
+    fn drawn(&self) -> &PolyMesh {
+        self.kept.as_ref().unwrap_or(&self.file.mesh)
     }
 
     /// Metres per unit of the file's coordinates, when its format says (E57, glTF/GLB).
@@ -38,7 +53,7 @@ impl LoadedScan {
         Ok(serde_wasm_bindgen::to_value(&self.file.format)?)
     }
 
-    /// Number of points (vertices).
+    /// Number of points (vertices) in the file, strays included (see [`LoadedScan::strays`]).
     #[wasm_bindgen(getter, js_name = numPoints)]
     pub fn num_points(&self) -> usize {
         self.file.mesh.num_vertices()
@@ -52,24 +67,28 @@ impl LoadedScan {
 
     /// Point positions for drawing: `x, y, z` per point (f32).
     pub fn positions(&self) -> Vec<f32> {
-        buffers::to_f32_xyz(self.file.mesh.positions())
+        buffers::to_f32_xyz(self.drawn().positions())
     }
 
     /// Smooth vertex normals for drawing the triangles: `x, y, z` per point (f32).
     pub fn normals(&self) -> Vec<f32> {
-        buffers::vertex_normals(self.file.mesh.positions(), &self.file.mesh.triangles())
+        buffers::vertex_normals(self.drawn().positions(), &self.drawn().triangles())
     }
 
     /// Triangle vertex indices, three per triangle.
     pub fn indices(&self) -> Vec<u32> {
-        self.file.mesh.triangles().into_iter().flatten().collect()
+        self.drawn().triangles().into_iter().flatten().collect()
+    }
+
+    /// Indices of the points left out as strays (a fit leaves them out too), in order.
+    pub fn strays(&self) -> Vec<u32> {
+        self.strays.clone()
     }
 
     /// Smallest corner of the bounding box, `[x, y, z]` (f64), or empty when there are no points.
     #[wasm_bindgen(js_name = bboxMin)]
     pub fn bbox_min(&self) -> Vec<f64> {
-        self.file
-            .mesh
+        self.drawn()
             .bbox()
             .map_or(Vec::new(), |b| b.min.to_array().to_vec())
     }
@@ -77,8 +96,7 @@ impl LoadedScan {
     /// Largest corner of the bounding box, `[x, y, z]` (f64), or empty when there are no points.
     #[wasm_bindgen(js_name = bboxMax)]
     pub fn bbox_max(&self) -> Vec<f64> {
-        self.file
-            .mesh
+        self.drawn()
             .bbox()
             .map_or(Vec::new(), |b| b.max.to_array().to_vec())
     }

@@ -428,8 +428,8 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
   });
 
   test('user files from the corpus fit with no setting touched; repairs are listed', async () => {
-    // A fresh page, nothing edited: the form holds what the page starts with (the first
-    // sample's preset tolerances, 0.1 % / 0.5 %) and the core's defaults for the rest.
+    // A fresh page, nothing edited: a dropped file gets the core's defaults (the first
+    // sample's preset sets only the scheme), the same as `geofit fit FILE`.
     const fresh = await browser.newPage({ viewport: { width: 1100, height: 800 } });
     try {
       fresh.on('pageerror', (e) => problems.push(`corpus page error: ${e.message}`));
@@ -454,6 +454,42 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
           assert.match(await fresh.textContent('#fit-intake'), repaired);
         }
       }
+    } finally {
+      await fresh.close();
+    }
+  });
+
+  test('a stray point is listed, left out of the view and the fit, and the fit converges', async () => {
+    const fresh = await browser.newPage({ viewport: { width: 1100, height: 800 } });
+    try {
+      fresh.on('pageerror', (e) => problems.push(`strays page error: ${e.message}`));
+      await fresh.goto(page.url());
+      await fresh.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
+      assert.equal(await fresh.isHidden('#strays-row'), true, 'the bundled bunny has no strays');
+      // The range-scan sample's preset (B-spline surface, 200 initial) must not carry over to
+      // a file of the user's: that gets the core's defaults, as `geofit fit FILE` does.
+      await pickSample(fresh, 'bun000-points.xyz', '5,032');
+      assert.equal(await fresh.inputValue('#fit-scheme'), 'bspline-surface');
+      // The page's own sample with one scanner stray 50 units away (the bunny is 0.2 across),
+      // appended as vertex 2007 in no face.
+      const text = readFileSync(join(ROOT, 'www', 'samples', 'bunny.obj'), 'utf8') + 'v 50 0 0\n';
+      await fresh.setInputFiles('#file', { name: 'bunny-with-stray.obj', mimeType: 'model/obj', buffer: Buffer.from(text) });
+      await fresh.waitForFunction(() => document.getElementById('file-name').textContent === 'bunny-with-stray.obj', null, { timeout: TIMEOUT_MS });
+      await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+      assert.equal(await fresh.inputValue('#fit-scheme'), 'loop');
+      assert.equal(await fresh.inputValue('#fit-initial'), '', 'automatic, from the data');
+      const spec = await fresh.evaluate(async () => (await import(new URL('../pkg/geofit.js', location.href).href)).defaultSpec('loop'));
+      assert.equal(await fresh.inputValue('#fit-tol-max'), String(spec.tolMax));
+      assert.equal(await fresh.inputValue('#fit-tol-avg'), String(spec.tolAvg));
+      assert.equal(await fresh.isHidden('#strays-row'), false);
+      assert.match(await fresh.textContent('#strays'), /^1 \(point 2007\)/);
+      assert.equal(await fresh.textContent('#num-points'), '2,008', 'the file\'s points, the stray among them');
+      const stats = await playToEnd(fresh);
+      console.log(`[e2e] ${backend.name} bunny with a stray: ${JSON.stringify(stats)}`);
+      assert.equal(stats.status, 'converged');
+      assert.ok(stats.eMaxPct <= 0.5 && Number.isFinite(stats.eBackMaxPct), JSON.stringify(stats));
+      // The diagonal is the bunny's, not the stray's 50 units.
+      assert.ok(stats.diagonal < 1, JSON.stringify(stats));
     } finally {
       await fresh.close();
     }

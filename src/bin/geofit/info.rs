@@ -19,7 +19,8 @@ pub struct Args {
 /// (E57, LAS/LAZ, PTX) add `scans` and `grid_kept` (a file of several scans keeps no grid);
 /// formats that define their unit (E57, glTF/GLB: metres) add `unit_to_metres`. A mesh adds
 /// `repairs`: what the repair every fit starts with would change ([`geofit::mesh::RepairReport`]:
-/// counts per kind, the first few indices of each, and a one-line `summary`).
+/// counts per kind, the first few indices of each, and a one-line `summary`). Points a fit would
+/// leave out as strays ([`geofit::geom::find_strays`]) add `strays` (`count`, `first`).
 pub fn run(args: Args) -> Result<(), String> {
     let loaded = read_input(&args.file)?;
     let mesh = &loaded.mesh;
@@ -45,6 +46,13 @@ pub fn run(args: Args) -> Result<(), String> {
         let repaired =
             geofit::mesh::repair(mesh).map_err(|e| format!("{}: {e}", args.file.display()))?;
         report["repairs"] = serde_json::to_value(&repaired.report).map_err(|e| e.to_string())?;
+    }
+    let strays = geofit::geom::find_strays(mesh.positions());
+    if !strays.is_empty() {
+        report["strays"] = serde_json::json!({
+            "count": strays.len(),
+            "first": &strays[..strays.len().min(5)],
+        });
     }
     if !loaded.polylines.is_empty() {
         report["polylines"] = loaded.polylines.len().into();

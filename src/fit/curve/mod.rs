@@ -180,9 +180,7 @@ impl CurveData {
     /// before it. A closed polyline given with its first point repeated at the end loses the
     /// repeat.
     pub fn try_new(points: &[Point3], closed: bool, needed: usize) -> Result<CurveData, FitError> {
-        if let Some(index) = points.iter().position(|p| !p.is_finite()) {
-            return Err(FitError::NonFinitePoint { index });
-        }
+        crate::geom::check_coordinates(points)?;
         let mut points = points.to_vec();
         if closed && points.len() > 1 && points.first() == points.last() {
             points.pop();

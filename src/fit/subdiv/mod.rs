@@ -131,9 +131,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
     ) -> Result<Self, FitError> {
         let start = Instant::now();
         options.validate()?;
-        if let Some(index) = data_points.iter().position(|p| !p.is_finite()) {
-            return Err(FitError::NonFinitePoint { index });
-        }
+        crate::geom::check_coordinates(data_points)?;
         if data_points.is_empty() {
             return Err(FitError::TooFewPoints {
                 found: 0,

@@ -115,7 +115,8 @@ impl Parameterization {
     }
 }
 
-/// Checks that there are at least `needed` points and that all are finite.
+/// Checks that there are at least `needed` points and that all coordinates are finite and in
+/// range.
 pub fn check_points(points: &[Point3], needed: usize) -> Result<(), FitError> {
     if points.len() < needed {
         return Err(FitError::TooFewPoints {
@@ -123,10 +124,7 @@ pub fn check_points(points: &[Point3], needed: usize) -> Result<(), FitError> {
             needed,
         });
     }
-    match points.iter().position(|p| !p.is_finite()) {
-        Some(index) => Err(FitError::NonFinitePoint { index }),
-        None => Ok(()),
-    }
+    Ok(crate::geom::check_coordinates(points)?)
 }
 
 /// Parameters by projection onto a plane along `opts.view` (default: least-variance axis).

@@ -57,6 +57,7 @@ mod verify;
 pub use deviation::{deviation, foldovers, Deviation, Foldovers};
 pub use error::SimplifyError;
 
+use crate::geom::Point3;
 use crate::mesh::repair::{repair, RepairReport};
 use crate::mesh::PolyMesh;
 use check::Limits;
@@ -260,11 +261,15 @@ pub fn simplify_with_report(
     if mesh.is_point_cloud() {
         return Err(SimplifyError::NoFaces);
     }
-    let (mut engine, repair) = working_mesh(mesh, options.boundary_weight)?;
+    // Quadrics hold squared plane offsets: far from the origin (a scan in survey coordinates)
+    // their costs cancel catastrophically, so the engine works around the bbox centre.
+    let origin = mesh.bbox().map_or(Point3::ZERO, |b| b.center());
+    let (mut engine, repair) = working_mesh(mesh, origin, options.boundary_weight)?;
     let (passes, relaxations) = reduce(&mut engine, target, &options.stages());
     let max_valence = engine.max_valence();
     let live = engine.live();
-    let (positions, tris) = engine.into_parts();
+    let (mut positions, tris) = engine.into_parts();
+    positions.iter_mut().for_each(|p| *p += origin);
     let starts = (0..=tris.len() as u32 / 3).map(|f| 3 * f).collect();
     let mesh = PolyMesh::from_parts_unchecked(positions, starts, tris);
     let report = SimplifyReport {
@@ -280,19 +285,17 @@ pub fn simplify_with_report(
     Ok(Simplified { mesh, report })
 }
 
-/// The working mesh of `mesh` (fan-triangulated, and repaired unless it is clean already) and
-/// the repair's report.
+/// The working mesh of `mesh` (fan-triangulated, and repaired unless it is clean already),
+/// with positions relative to `origin`, and the repair's report.
 fn working_mesh(
     mesh: &PolyMesh,
+    origin: Point3,
     boundary_weight: f64,
 ) -> Result<(Engine, RepairReport), SimplifyError> {
     let triangles = triangulated(mesh);
     let (_, idx) = triangles.raw_faces();
-    let engine = Engine::new(
-        triangles.positions().to_vec(),
-        idx.to_vec(),
-        boundary_weight,
-    );
+    let local = |pos: &[Point3]| pos.iter().map(|&p| p - origin).collect();
+    let engine = Engine::new(local(triangles.positions()), idx.to_vec(), boundary_weight);
     if let Some(report) = verify::clean_report(&engine) {
         return Ok((engine, report));
     }
@@ -302,7 +305,10 @@ fn working_mesh(
     if tris.is_empty() {
         return Err(SimplifyError::NoFaces);
     }
-    Ok((Engine::new(pos, tris, boundary_weight), repaired.report))
+    Ok((
+        Engine::new(local(&pos), tris, boundary_weight),
+        repaired.report,
+    ))
 }
 
 /// `mesh` with its polygons fan-triangulated (the mesh itself when it has only triangles).
