@@ -71,7 +71,7 @@ impl SubdivFitOptions {
     /// The tolerances a fit stops at when none are given: E_avg 0.1 %, E_max 0.5 % of the
     /// diagonal. A default is what a user gets who presses Play on their own scan, so it is one
     /// the scans the fitter meets can reach within the default budget (half the data points):
-    /// over `data/` and the corpus, 31 of 41 fits converge at these, 7 of 37 at the patent's
+    /// over `data/` and the corpus, 31 of 41 fits converge at these, 7 of 38 at the patent's
     /// Table 1 figures (E_avg 0.01 %, E_max 0.05 %, [`Tolerances::DEFAULT`]), which the
     /// benchmarks give explicitly.
     pub const DEFAULT_TOLERANCES: Tolerances = Tolerances {
