@@ -20,7 +20,7 @@ use super::{
 };
 use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
-use crate::subdiv::{tessellate, LimitSurface, PatchDomain, SurfaceParam};
+use crate::subdiv::{tessellate, LimitSurface, PatchDomain, SubdivError, SurfaceParam};
 use frozen::{Fairness, Stencils};
 use index::SurfaceIndex;
 use std::collections::HashSet;
@@ -440,7 +440,17 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 }
                 let old_faces = self.patch_faces_now(&control);
                 let before = self.state.stats().e_rms;
-                self.surface = self.surface.rebuild(&refined)?;
+                self.surface = match self.surface.rebuild(&refined) {
+                    Ok(surface) => surface,
+                    // The split gave a face more neighbours than a patch can depend on (seen
+                    // with Doo–Sabin, whose split faces hand extra corners to their
+                    // neighbours): fewer splits, or none.
+                    Err(FitError::Subdiv(SubdivError::NeighbourhoodTooLarge { .. })) => {
+                        chosen.truncate(chosen.len() / 2);
+                        continue;
+                    }
+                    Err(e) => return Err(e),
+                };
                 self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
                 self.accel.reset();
                 self.carry_feet_over(&old_faces, &refined)?;
