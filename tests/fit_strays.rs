@@ -150,7 +150,7 @@ fn no_statistic_is_nan_or_infinite_at_extreme_scales_and_offsets() {
             Scheme::BsplineSurface,
         ] {
             let report = fit(&moved, scheme);
-            assert!(report.history.len() > 0 || report.converged);
+            assert!(!report.history.is_empty() || report.converged);
             for (name, value) in statistics(&report) {
                 assert!(
                     value.is_finite(),
