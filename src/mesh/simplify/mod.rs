@@ -262,8 +262,12 @@ pub fn simplify_with_report(
         return Err(SimplifyError::NoFaces);
     }
     // Quadrics hold squared plane offsets: far from the origin (a scan in survey coordinates)
-    // their costs cancel catastrophically, so the engine works around the bbox centre.
-    let origin = mesh.bbox().map_or(Point3::ZERO, |b| b.center());
+    // their costs cancel catastrophically, so such a mesh is simplified around its bbox
+    // centre. Near the origin nothing is gained and the shift's rounding would change results.
+    let origin = mesh
+        .bbox()
+        .filter(|b| b.center().length() > b.diagonal())
+        .map_or(Point3::ZERO, |b| b.center());
     let (mut engine, repair) = working_mesh(mesh, origin, options.boundary_weight)?;
     let (passes, relaxations) = reduce(&mut engine, target, &options.stages());
     let max_valence = engine.max_valence();
