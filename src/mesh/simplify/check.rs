@@ -26,13 +26,12 @@ pub(super) struct Limits {
 }
 
 /// A face around a vertex, seen from it: the face, the corner after the vertex and the corner
-/// before it (in the face's orientation), and the normal of the input the face stands for.
+/// before it (in the face's orientation).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Corner {
     pub(super) face: u32,
     pub(super) next: u32,
     pub(super) prev: u32,
-    pub(super) normal: Vec3,
 }
 
 impl Corner {
@@ -79,10 +78,14 @@ impl Ring {
         &self.opposite[..self.shared.min(2)]
     }
 
-    /// The faces the collapse of `a`–`b` removes, each with its input normal and the faces
-    /// that inherit it: the faces across its other two sides (which become neighbours), where
-    /// they exist.
-    pub(super) fn removed_faces(&self, a: u32, b: u32) -> Vec<(Vec3, [Option<u32>; 2])> {
+    /// The faces the collapse of `a`–`b` removes, each with the faces that inherit its input
+    /// normal: the faces across its other two sides (which become neighbours), where they
+    /// exist.
+    pub(super) fn removed_faces(
+        &self,
+        a: u32,
+        b: u32,
+    ) -> impl Iterator<Item = (u32, [Option<u32>; 2])> + '_ {
         let heir = |around: &[Corner], x: u32, other: u32| {
             around
                 .iter()
@@ -91,15 +94,14 @@ impl Ring {
         };
         self.around_a
             .iter()
-            .filter(|c| c.has(b))
-            .map(|c| {
+            .filter(move |c| c.has(b))
+            .map(move |c| {
                 let x = if c.next == b { c.prev } else { c.next };
                 (
-                    c.normal,
+                    c.face,
                     [heir(&self.around_a, x, b), heir(&self.around_b, x, a)],
                 )
             })
-            .collect()
     }
 
     /// Faces the merged vertex keeps.
@@ -158,7 +160,7 @@ impl Ring {
                 let n_old = (u - x).cross(w - x);
                 let n_new = (u - p).cross(w - p);
                 if n_new == Vec3::ZERO
-                    || !within(c.normal, n_new, l.min_reference_cos)
+                    || !within(e.reference_normal(c.face), n_new, l.min_reference_cos)
                     || !within(n_old, n_new, l.min_normal_cos)
                 {
                     return false;
