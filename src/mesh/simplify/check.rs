@@ -152,7 +152,8 @@ impl Ring {
         p: Point3,
         l: &Limits,
     ) -> bool {
-        let mut min_new = f64::INFINITY;
+        let limit = l.min_quality * l.min_quality / 12.0;
+        let mut needles = false;
         for (end, other, around) in [(a, b, &self.around_a), (b, a, &self.around_b)] {
             let x = e.pos(end);
             for c in around.iter().filter(|c| !c.has(other)) {
@@ -165,11 +166,25 @@ impl Ring {
                 {
                     return false;
                 }
-                min_new = min_new.min(shape(n_new, p, u, w));
+                // `shape` below the limit, without its division.
+                let sum_sq = side_sum_sq(p, u, w);
+                needles |= n_new.length_squared() < limit * sum_sq * sum_sq;
             }
         }
         // The old triangles' shape only matters when a new one is below the limit.
-        min_new >= l.min_quality * l.min_quality / 12.0 || self.worst_old_shape(e, a, b) <= min_new
+        !needles || self.worst_old_shape(e, a, b) <= self.worst_new_shape(e, a, b, p)
+    }
+
+    /// The smallest [`shape`] of the faces around the edge after moving `a` and `b` to `p`.
+    fn worst_new_shape(&self, e: &Engine, a: u32, b: u32, p: Point3) -> f64 {
+        let mut worst = f64::INFINITY;
+        for (other, around) in [(b, &self.around_a), (a, &self.around_b)] {
+            for c in around.iter().filter(|c| !c.has(other)) {
+                let (u, w) = (e.pos(c.next), e.pos(c.prev));
+                worst = worst.min(shape((u - p).cross(w - p), p, u, w));
+            }
+        }
+        worst
     }
 
     /// The smallest [`shape`] of the faces around the edge before the collapse (those that
@@ -197,12 +212,17 @@ fn within(n_old: Vec3, n_new: Vec3, min_cos: f64) -> bool {
 /// The squared triangle quality over 12 (|n|² / (Σ edge²)², n the doubled-area normal of the
 /// triangle `a`, `b`, `c`): the quality test without roots.
 fn shape(n: Vec3, a: Point3, b: Point3, c: Point3) -> f64 {
-    let sum_sq = (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared();
+    let sum_sq = side_sum_sq(a, b, c);
     if sum_sq > 0.0 {
         n.length_squared() / (sum_sq * sum_sq)
     } else {
         0.0
     }
+}
+
+/// The sum of the squared sides of the triangle `a`, `b`, `c`.
+fn side_sum_sq(a: Point3, b: Point3, c: Point3) -> f64 {
+    (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared()
 }
 
 /// The neighbours of a vertex from its faces `around`, sorted, into `out`. The faces around a

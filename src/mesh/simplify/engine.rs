@@ -100,16 +100,15 @@ pub(super) struct Engine {
 
 impl Engine {
     /// The working mesh of `pos` and the triangles `tris` (an oriented manifold with
-    /// boundary), with `boundary_weight` for the penalty planes along open edges.
-    pub(super) fn new(pos: Vec<Point3>, tris: Vec<u32>, boundary_weight: f64) -> Engine {
+    /// boundary; both are copied into working order), with `boundary_weight` for the penalty planes along open edges.
+    pub(super) fn new(pos: &[Point3], tris: &[u32], boundary_weight: f64) -> Engine {
         let n = pos.len();
-        let numbering = Numbering::spatial(&pos);
+        let numbering = Numbering::spatial(pos);
         let (pos, tris) = numbering.apply(pos, tris);
         let normal_unit = normal_unit(&pos);
         let tris: Vec<Face> = tris
-            .chunks_exact(3)
-            .map(|t| {
-                let v = [t[0], t[1], t[2]];
+            .into_iter()
+            .map(|v| {
                 let [a, b, c] = v.map(|v| pos[v as usize]);
                 let normal = compact((b - a).cross(c - a) * (0.5 / normal_unit));
                 Face { v, normal }

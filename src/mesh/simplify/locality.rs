@@ -32,35 +32,35 @@ impl Numbering {
 
     /// `pos` and the triangles `tris` in working numbering, the triangles ordered by their
     /// lowest corner (ties in input order).
-    pub(super) fn apply(&self, pos: Vec<Point3>, tris: Vec<u32>) -> (Vec<Point3>, Vec<u32>) {
+    pub(super) fn apply(&self, pos: &[Point3], tris: &[u32]) -> (Vec<Point3>, Vec<[u32; 3]>) {
         let mut moved = vec![Point3::ZERO; pos.len()];
-        for (v, p) in pos.into_iter().enumerate() {
-            moved[self.work[v] as usize] = p;
+        for (&w, &p) in self.work.iter().zip(pos) {
+            moved[w as usize] = p;
         }
-        let renamed: Vec<u32> = tris.iter().map(|&v| self.work[v as usize]).collect();
-        drop(tris);
-        (moved, faces_by_lowest_corner(&renamed, self.work.len()))
+        (moved, self.faces_by_lowest_corner(tris))
     }
-}
 
-/// The triangles `tris` ordered by their lowest corner with a counting sort (stable).
-fn faces_by_lowest_corner(tris: &[u32], vertices: usize) -> Vec<u32> {
-    let lowest = |t: &[u32]| t[0].min(t[1]).min(t[2]) as usize;
-    let mut start = vec![0u32; vertices + 1];
-    for t in tris.chunks_exact(3) {
-        start[lowest(t) + 1] += 1;
+    /// The triangles `tris` renamed to working indices and ordered by their lowest corner with
+    /// a counting sort (stable).
+    fn faces_by_lowest_corner(&self, tris: &[u32]) -> Vec<[u32; 3]> {
+        let rename = |t: &[u32]| [t[0], t[1], t[2]].map(|v| self.work[v as usize]);
+        let lowest = |t: [u32; 3]| t[0].min(t[1]).min(t[2]) as usize;
+        let mut start = vec![0u32; self.work.len() + 1];
+        for t in tris.chunks_exact(3) {
+            start[lowest(rename(t)) + 1] += 1;
+        }
+        for v in 0..self.work.len() {
+            start[v + 1] += start[v];
+        }
+        let mut out = vec![[0u32; 3]; tris.len() / 3];
+        for t in tris.chunks_exact(3) {
+            let t = rename(t);
+            let slot = &mut start[lowest(t)];
+            out[*slot as usize] = t;
+            *slot += 1;
+        }
+        out
     }
-    for v in 0..vertices {
-        start[v + 1] += start[v];
-    }
-    let mut out = vec![0u32; tris.len()];
-    for t in tris.chunks_exact(3) {
-        let slot = &mut start[lowest(t)];
-        let k = 3 * *slot as usize;
-        out[k..k + 3].copy_from_slice(t);
-        *slot += 1;
-    }
-    out
 }
 
 /// Bits of the code a pass of [`sorted_by_code`] sorts by.
@@ -160,9 +160,9 @@ mod tests {
         seen.sort_unstable();
         assert_eq!(seen, (0..40).collect::<Vec<u32>>());
         assert!((0..40).step_by(2).all(|v| n.work[v] < 20));
-        let (moved, faces) = n.apply(pos.clone(), tris);
+        let (moved, faces) = n.apply(&pos, &tris);
         assert_eq!(moved[n.work[7] as usize], pos[7]);
-        let lows: Vec<u32> = faces.chunks(3).map(|t| *t.iter().min().unwrap()).collect();
+        let lows: Vec<u32> = faces.iter().map(|t| *t.iter().min().unwrap()).collect();
         assert!(lows.windows(2).all(|w| w[0] <= w[1]));
     }
 }

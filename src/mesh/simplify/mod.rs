@@ -288,11 +288,7 @@ fn working_mesh(
 ) -> Result<(Engine, RepairReport), SimplifyError> {
     let triangles = triangulated(mesh);
     let (_, idx) = triangles.raw_faces();
-    let engine = Engine::new(
-        triangles.positions().to_vec(),
-        idx.to_vec(),
-        boundary_weight,
-    );
+    let engine = Engine::new(triangles.positions(), idx, boundary_weight);
     if let Some(report) = verify::clean_report(&engine) {
         return Ok((engine, report));
     }
@@ -302,7 +298,7 @@ fn working_mesh(
     if tris.is_empty() {
         return Err(SimplifyError::NoFaces);
     }
-    Ok((Engine::new(pos, tris, boundary_weight), repaired.report))
+    Ok((Engine::new(&pos, &tris, boundary_weight), repaired.report))
 }
 
 /// `mesh` with its polygons fan-triangulated (the mesh itself when it has only triangles).
