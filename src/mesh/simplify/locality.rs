@@ -137,7 +137,9 @@ mod tests {
 
     #[test]
     fn radix_order_is_a_stable_sort() {
-        let code: Vec<u64> = (0..5000u64).map(|k| (k * 7919) % 613 << (k % 50)).collect();
+        let code: Vec<u64> = (0..5000u64)
+            .map(|k| ((k * 7919) % 613) << (k % 50))
+            .collect();
         let mut expected: Vec<u32> = (0..code.len() as u32).collect();
         expected.sort_by_key(|&v| (code[v as usize], v));
         assert_eq!(sorted_by_code(&code), expected);
