@@ -182,9 +182,11 @@ def print_rows(rows):
             extra += f"  peak RSS {r['peak_rss_bytes_per_triangle']:.0f} B/tri"
         if r.get("relaxations"):
             extra += f"  relaxed x{r['relaxations']}"
+        num = lambda x, spec: "n/a" if x is None else format(x, spec)
         print(f"{r['mesh']:16s} {r['tool']:20s} {r['input_triangles']:>9,d} tri -> {r['vertices']:>5d} v "
-              f"{r['cpu_s']:8.3f} s {r['mtri_per_s']:6.2f} M tri/s  max {r['deviation_max_pct']:.3f} %"
-              f"  rms {r['deviation_rms_pct']:.3f} %  fold-overs {r['foldovers']}{extra}")
+              f"{num(r['cpu_s'], '8.3f')} s {num(r['mtri_per_s'], '6.2f')} M tri/s"
+              f"  max {num(r['deviation_max_pct'], '.3f')} %  rms {num(r['deviation_rms_pct'], '.3f')} %"
+              f"  fold-overs {r['foldovers']}{extra}")
 
 
 if __name__ == "__main__":

@@ -26,13 +26,12 @@ pub(super) struct Limits {
 }
 
 /// A face around a vertex, seen from it: the face, the corner after the vertex and the corner
-/// before it (in the face's orientation), and the normal of the input the face stands for.
+/// before it (in the face's orientation).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Corner {
     pub(super) face: u32,
     pub(super) next: u32,
     pub(super) prev: u32,
-    pub(super) normal: Vec3,
 }
 
 impl Corner {
@@ -79,10 +78,14 @@ impl Ring {
         &self.opposite[..self.shared.min(2)]
     }
 
-    /// The faces the collapse of `a`–`b` removes, each with its input normal and the faces
-    /// that inherit it: the faces across its other two sides (which become neighbours), where
-    /// they exist.
-    pub(super) fn removed_faces(&self, a: u32, b: u32) -> Vec<(Vec3, [Option<u32>; 2])> {
+    /// The faces the collapse of `a`–`b` removes, each with the faces that inherit its input
+    /// normal: the faces across its other two sides (which become neighbours), where they
+    /// exist.
+    pub(super) fn removed_faces(
+        &self,
+        a: u32,
+        b: u32,
+    ) -> impl Iterator<Item = (u32, [Option<u32>; 2])> + '_ {
         let heir = |around: &[Corner], x: u32, other: u32| {
             around
                 .iter()
@@ -91,15 +94,14 @@ impl Ring {
         };
         self.around_a
             .iter()
-            .filter(|c| c.has(b))
-            .map(|c| {
+            .filter(move |c| c.has(b))
+            .map(move |c| {
                 let x = if c.next == b { c.prev } else { c.next };
                 (
-                    c.normal,
+                    c.face,
                     [heir(&self.around_a, x, b), heir(&self.around_b, x, a)],
                 )
             })
-            .collect()
     }
 
     /// Faces the merged vertex keeps.
@@ -150,7 +152,8 @@ impl Ring {
         p: Point3,
         l: &Limits,
     ) -> bool {
-        let mut min_new = f64::INFINITY;
+        let limit = l.min_quality * l.min_quality / 12.0;
+        let mut needles = false;
         for (end, other, around) in [(a, b, &self.around_a), (b, a, &self.around_b)] {
             let x = e.pos(end);
             for c in around.iter().filter(|c| !c.has(other)) {
@@ -158,16 +161,30 @@ impl Ring {
                 let n_old = (u - x).cross(w - x);
                 let n_new = (u - p).cross(w - p);
                 if n_new == Vec3::ZERO
-                    || !within(c.normal, n_new, l.min_reference_cos)
+                    || !within(e.reference_normal(c.face), n_new, l.min_reference_cos)
                     || !within(n_old, n_new, l.min_normal_cos)
                 {
                     return false;
                 }
-                min_new = min_new.min(shape(n_new, p, u, w));
+                // `shape` below the limit, without its division.
+                let sum_sq = side_sum_sq(p, u, w);
+                needles |= n_new.length_squared() < limit * sum_sq * sum_sq;
             }
         }
         // The old triangles' shape only matters when a new one is below the limit.
-        min_new >= l.min_quality * l.min_quality / 12.0 || self.worst_old_shape(e, a, b) <= min_new
+        !needles || self.worst_old_shape(e, a, b) <= self.worst_new_shape(e, a, b, p)
+    }
+
+    /// The smallest [`shape`] of the faces around the edge after moving `a` and `b` to `p`.
+    fn worst_new_shape(&self, e: &Engine, a: u32, b: u32, p: Point3) -> f64 {
+        let mut worst = f64::INFINITY;
+        for (other, around) in [(b, &self.around_a), (a, &self.around_b)] {
+            for c in around.iter().filter(|c| !c.has(other)) {
+                let (u, w) = (e.pos(c.next), e.pos(c.prev));
+                worst = worst.min(shape((u - p).cross(w - p), p, u, w));
+            }
+        }
+        worst
     }
 
     /// The smallest [`shape`] of the faces around the edge before the collapse (those that
@@ -195,12 +212,17 @@ fn within(n_old: Vec3, n_new: Vec3, min_cos: f64) -> bool {
 /// The squared triangle quality over 12 (|n|² / (Σ edge²)², n the doubled-area normal of the
 /// triangle `a`, `b`, `c`): the quality test without roots.
 fn shape(n: Vec3, a: Point3, b: Point3, c: Point3) -> f64 {
-    let sum_sq = (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared();
+    let sum_sq = side_sum_sq(a, b, c);
     if sum_sq > 0.0 {
         n.length_squared() / (sum_sq * sum_sq)
     } else {
         0.0
     }
+}
+
+/// The sum of the squared sides of the triangle `a`, `b`, `c`.
+fn side_sum_sq(a: Point3, b: Point3, c: Point3) -> f64 {
+    (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared()
 }
 
 /// The neighbours of a vertex from its faces `around`, sorted, into `out`. The faces around a

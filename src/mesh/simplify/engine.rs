@@ -22,6 +22,7 @@ use super::locality::Numbering;
 use super::quadric::{placement, Quadric};
 use super::rank::cost_at_rank;
 use crate::geom::{Point3, Vec3};
+use std::mem::take;
 
 /// Below this share of the collapses still needed, a pass does not stop for cost (passes on
 /// meshes of odd topology, where most collapses are refused, still make progress).
@@ -53,7 +54,9 @@ struct Candidate {
 #[derive(Clone, Copy, Debug)]
 struct Face {
     v: [u32; 3],
-    normal: Vec3,
+    /// The normal in units of [`Engine::normal_unit`], stored compactly: only its direction
+    /// is ever tested, against a loose angle.
+    normal: [f32; 3],
 }
 
 /// The mesh being simplified: an oriented manifold triangle mesh with boundary.
@@ -81,26 +84,33 @@ pub(super) struct Engine {
     /// The wave under way (see [`Engine::waves`]), counted over all passes.
     wave: u64,
     /// The cheapest candidate of each vertex in a wave: the wave in the high 32 bits, the
-    /// candidate's index in the low ones.
-    cheapest: Vec<u64>,
+    /// candidate's index in the low ones; and its cost, kept beside it so that marking reads
+    /// no other candidate.
+    cheapest: Vec<(u64, f64)>,
     ring: Ring,
+    /// The buffers of a pass, kept from pass to pass: fresh ones of this size would each be
+    /// mapped and zeroed by the system anew, which on a large mesh took a fifth of the time.
+    dear: Vec<Candidate>,
+    open: Vec<Candidate>,
+    histogram: Vec<u32>,
+    turn: Vec<u32>,
     /// How working indices relate to the input's.
     numbering: Numbering,
 }
 
 impl Engine {
     /// The working mesh of `pos` and the triangles `tris` (an oriented manifold with
-    /// boundary), with `boundary_weight` for the penalty planes along open edges.
-    pub(super) fn new(pos: Vec<Point3>, tris: Vec<u32>, boundary_weight: f64) -> Engine {
+    /// boundary; both are copied into working order), with `boundary_weight` for the penalty planes along open edges.
+    pub(super) fn new(pos: &[Point3], tris: &[u32], boundary_weight: f64) -> Engine {
         let n = pos.len();
-        let numbering = Numbering::spatial(&pos);
+        let numbering = Numbering::spatial(pos);
         let (pos, tris) = numbering.apply(pos, tris);
+        let normal_unit = normal_unit(&pos);
         let tris: Vec<Face> = tris
-            .chunks_exact(3)
-            .map(|t| {
-                let v = [t[0], t[1], t[2]];
+            .into_iter()
+            .map(|v| {
                 let [a, b, c] = v.map(|v| pos[v as usize]);
-                let normal = 0.5 * (b - a).cross(c - a);
+                let normal = compact((b - a).cross(c - a) * (0.5 / normal_unit));
                 Face { v, normal }
             })
             .collect();
@@ -117,8 +127,12 @@ impl Engine {
             live: 0,
             worst: 0.0,
             wave: 0,
-            cheapest: vec![0; n],
+            cheapest: vec![(0, 0.0); n],
             ring: Ring::default(),
+            dear: Vec::new(),
+            open: Vec::new(),
+            histogram: Vec::new(),
+            turn: Vec::new(),
             numbering,
         };
         e.index_faces();
@@ -162,6 +176,13 @@ impl Engine {
         self.tris[f].v
     }
 
+    /// The area-weighted normal of the input face `f` stands for (see [`Face`]), in units of
+    /// the engine's own choosing: only its direction means anything.
+    pub(super) fn reference_normal(&self, f: u32) -> Vec3 {
+        let [x, y, z] = self.tris[f as usize].normal;
+        Vec3::new(f64::from(x), f64::from(y), f64::from(z))
+    }
+
     /// Input indices of the vertices in no face, in order.
     pub(super) fn unreferenced_inputs(&self) -> impl Iterator<Item = usize> + '_ {
         let work = &self.numbering.work;
@@ -178,8 +199,7 @@ impl Engine {
     /// merged corners renamed; faces that a collapse in this pass removed are left out.
     pub(super) fn live_corners(&self, v: u32, out: &mut Vec<Corner>) {
         for &f in self.faces_of(v) {
-            let face = &self.tris[f as usize];
-            let t = face.v;
+            let t = self.tris[f as usize].v;
             let k = if t[0] == v {
                 0
             } else if t[1] == v {
@@ -194,7 +214,6 @@ impl Engine {
                     face: f,
                     next,
                     prev,
-                    normal: face.normal,
                 });
             }
         }
@@ -206,23 +225,27 @@ impl Engine {
     /// Around a vertex of a manifold the faces form one fan, in which each face's next corner
     /// is the following face's previous one; so the sum of next minus previous corners over
     /// the vertex's faces is 0 for a closed fan and the difference of the two (distinct)
-    /// boundary neighbours for an open one: an exact boundary test with no sorting.
+    /// boundary neighbours for an open one: an exact boundary test with no sorting (exact in
+    /// wrapping `u32` arithmetic too, as two distinct indices differ modulo 2³²).
     fn index_faces(&mut self) {
         let n = self.pos.len();
         self.start.clear();
         self.start.resize(n + 1, 0);
-        let mut turn = vec![0i64; n];
+        let mut turn = take(&mut self.turn);
+        turn.clear();
+        turn.resize(n, 0);
         for f in &self.tris {
             let t = f.v;
             for k in 0..3 {
                 let (v, next, prev) = (t[k] as usize, t[(k + 1) % 3], t[(k + 2) % 3]);
                 self.start[v + 1] += 1;
-                turn[v] += i64::from(next) - i64::from(prev);
+                turn[v] = turn[v].wrapping_add(next.wrapping_sub(prev));
             }
         }
-        for (b, s) in self.boundary.iter_mut().zip(turn) {
+        for (b, &s) in self.boundary.iter_mut().zip(&turn) {
             *b = s != 0;
         }
+        self.turn = turn;
         for v in 0..n {
             self.face_count[v] = self.start[v + 1];
             self.start[v + 1] += self.start[v];
@@ -290,12 +313,15 @@ impl Engine {
     /// One pass of collapses towards `target` within `limits`; returns how many were made
     /// (none only when no edge could be collapsed).
     pub(super) fn pass(&mut self, target: usize, limits: &Limits) -> usize {
-        let mut dear = self.candidates();
+        let (mut dear, mut open) = (take(&mut self.dear), take(&mut self.open));
+        let mut histogram = take(&mut self.histogram);
+        self.candidates(&mut dear);
+        open.clear();
+        open.reserve(dear.len());
         let needed = self.live.saturating_sub(target);
         let enough = needed / MIN_PASS_SHARE;
-        let goal = GOAL_FACTOR * cost_at_rank(dear.iter().map(|c| c.cost), needed);
+        let goal = GOAL_FACTOR * cost_at_rank(dear.iter().map(|c| c.cost), needed, &mut histogram);
         let mut threshold = goal.max(self.worst);
-        let mut open = Vec::new();
         let mut done = 0;
         loop {
             // The waves see the candidates up to the threshold; the dearer ones wait.
@@ -313,8 +339,10 @@ impl Engine {
             // Too little within the goal (most collapses refused): admit about as many more
             // candidates as the pass still lacks, cheapest first.
             let lacking = enough + 1 - done;
-            threshold = cost_at_rank(dear.iter().map(|c| c.cost), lacking.min(dear.len() - 1));
+            let rank = lacking.min(dear.len() - 1);
+            threshold = cost_at_rank(dear.iter().map(|c| c.cost), rank, &mut histogram);
         }
+        (self.dear, self.open, self.histogram) = (dear, open, histogram);
         self.compact();
         self.index_faces();
         done
@@ -322,8 +350,9 @@ impl Engine {
 
     /// Every edge once, costed: from the face side that runs from its lower end, or from its
     /// only side on a boundary.
-    fn candidates(&self) -> Vec<Candidate> {
-        let mut out = Vec::with_capacity(3 * self.tris.len() / 2 + 1);
+    fn candidates(&self, out: &mut Vec<Candidate>) {
+        out.clear();
+        out.reserve(3 * self.tris.len() / 2 + 1);
         for f in &self.tris {
             let t = f.v;
             for k in 0..3 {
@@ -336,7 +365,6 @@ impl Engine {
                 }
             }
         }
-        out
     }
 
     /// Collapses, in waves, the candidates that are the cheapest at both their ends among
@@ -352,7 +380,7 @@ impl Engine {
             let mut tried = 0;
             for i in 0..cands.len() {
                 let c = cands[i];
-                let mine = |end: u32| self.cheapest[end as usize] == stamp | i as u64;
+                let mine = |end: u32| self.cheapest[end as usize].0 == stamp | i as u64;
                 if !mine(c.a) || !mine(c.b) {
                     continue;
                 }
@@ -392,8 +420,8 @@ impl Engine {
             cands[kept] = c;
             for end in [c.a, c.b] {
                 let slot = &mut self.cheapest[end as usize];
-                if *slot >> 32 != self.wave || cands[(*slot & 0xffff_ffff) as usize].cost > c.cost {
-                    *slot = stamp | kept as u64;
+                if slot.0 >> 32 != self.wave || slot.1 > c.cost {
+                    *slot = (stamp | kept as u64, c.cost);
                 }
             }
             kept += 1;
@@ -430,10 +458,11 @@ impl Engine {
         for &w in ring.opposite() {
             self.face_count[w as usize] -= 1;
         }
-        for (normal, heirs) in ring.removed_faces(a, b) {
-            let share = normal / heirs.iter().flatten().count().max(1) as f64;
+        for (face, heirs) in ring.removed_faces(a, b) {
+            let share = self.reference_normal(face) / heirs.iter().flatten().count().max(1) as f64;
             for g in heirs.into_iter().flatten() {
-                self.tris[g as usize].normal += share;
+                let normal = compact(self.reference_normal(g) + share);
+                self.tris[g as usize].normal = normal;
             }
         }
         self.live -= 1;
@@ -482,4 +511,22 @@ impl Engine {
             .collect();
         (positions, tris)
     }
+}
+
+/// The unit of the stored reference normals of `pos`: the square of its bounding box's largest
+/// side (1 for a single point), so that a face's stored normal is at most about 1.
+fn normal_unit(pos: &[Point3]) -> f64 {
+    let lo = pos.iter().fold(Point3::INFINITY, |a, &p| a.min(p));
+    let hi = pos.iter().fold(Point3::NEG_INFINITY, |a, &p| a.max(p));
+    let side = (hi - lo).max_element();
+    if side > 0.0 && side.is_finite() {
+        side * side
+    } else {
+        1.0
+    }
+}
+
+/// `n` in compact storage.
+fn compact(n: Vec3) -> [f32; 3] {
+    [n.x as f32, n.y as f32, n.z as f32]
 }

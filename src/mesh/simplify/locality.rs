@@ -22,9 +22,7 @@ pub(super) struct Numbering {
 impl Numbering {
     /// Vertices in Morton order of their positions (ties in input order).
     pub(super) fn spatial(pos: &[Point3]) -> Numbering {
-        let code = morton_codes(pos);
-        let mut order: Vec<u32> = (0..pos.len() as u32).collect();
-        order.sort_unstable_by_key(|&v| (code[v as usize], v));
+        let order = sorted_by_code(&morton_codes(pos));
         let mut work = vec![0u32; pos.len()];
         for (w, &v) in order.iter().enumerate() {
             work[v as usize] = w as u32;
@@ -34,35 +32,66 @@ impl Numbering {
 
     /// `pos` and the triangles `tris` in working numbering, the triangles ordered by their
     /// lowest corner (ties in input order).
-    pub(super) fn apply(&self, pos: Vec<Point3>, tris: Vec<u32>) -> (Vec<Point3>, Vec<u32>) {
+    pub(super) fn apply(&self, pos: &[Point3], tris: &[u32]) -> (Vec<Point3>, Vec<[u32; 3]>) {
         let mut moved = vec![Point3::ZERO; pos.len()];
-        for (v, p) in pos.into_iter().enumerate() {
-            moved[self.work[v] as usize] = p;
+        for (&w, &p) in self.work.iter().zip(pos) {
+            moved[w as usize] = p;
         }
-        let renamed: Vec<u32> = tris.iter().map(|&v| self.work[v as usize]).collect();
-        drop(tris);
-        (moved, faces_by_lowest_corner(&renamed, self.work.len()))
+        (moved, self.faces_by_lowest_corner(tris))
+    }
+
+    /// The triangles `tris` renamed to working indices and ordered by their lowest corner with
+    /// a counting sort (stable).
+    fn faces_by_lowest_corner(&self, tris: &[u32]) -> Vec<[u32; 3]> {
+        let rename = |t: &[u32]| [t[0], t[1], t[2]].map(|v| self.work[v as usize]);
+        let lowest = |t: [u32; 3]| t[0].min(t[1]).min(t[2]) as usize;
+        let mut start = vec![0u32; self.work.len() + 1];
+        for t in tris.chunks_exact(3) {
+            start[lowest(rename(t)) + 1] += 1;
+        }
+        for v in 0..self.work.len() {
+            start[v + 1] += start[v];
+        }
+        let mut out = vec![[0u32; 3]; tris.len() / 3];
+        for t in tris.chunks_exact(3) {
+            let t = rename(t);
+            let slot = &mut start[lowest(t)];
+            out[*slot as usize] = t;
+            *slot += 1;
+        }
+        out
     }
 }
 
-/// The triangles `tris` ordered by their lowest corner with a counting sort (stable).
-fn faces_by_lowest_corner(tris: &[u32], vertices: usize) -> Vec<u32> {
-    let lowest = |t: &[u32]| t[0].min(t[1]).min(t[2]) as usize;
-    let mut start = vec![0u32; vertices + 1];
-    for t in tris.chunks_exact(3) {
-        start[lowest(t) + 1] += 1;
+/// Bits of the code a pass of [`sorted_by_code`] sorts by.
+const DIGIT: u32 = 11;
+
+/// The indices of `code` in increasing order of code, ties in index order: a least
+/// significant digit radix sort, which is stable and takes a few linear passes where a
+/// comparison sort of millions of codes takes ten times as long.
+fn sorted_by_code(code: &[u64]) -> Vec<u32> {
+    let mut order: Vec<(u64, u32)> = code.iter().zip(0..).map(|(&c, v)| (c, v)).collect();
+    let mut next = vec![(0, 0); code.len()];
+    let bits = 64 - code.iter().fold(0, |a, &c| a | c).leading_zeros();
+    let mut count = vec![0u32; 1 << DIGIT];
+    for shift in (0..bits).step_by(DIGIT as usize) {
+        let digit = |c: u64| (c >> shift) as usize & ((1 << DIGIT) - 1);
+        count.fill(0);
+        for &(c, _) in &order {
+            count[digit(c)] += 1;
+        }
+        let mut sum = 0;
+        for k in &mut count {
+            (*k, sum) = (sum, sum + *k);
+        }
+        for &(c, v) in &order {
+            let slot = &mut count[digit(c)];
+            next[*slot as usize] = (c, v);
+            *slot += 1;
+        }
+        std::mem::swap(&mut order, &mut next);
     }
-    for v in 0..vertices {
-        start[v + 1] += start[v];
-    }
-    let mut out = vec![0u32; tris.len()];
-    for t in tris.chunks_exact(3) {
-        let slot = &mut start[lowest(t)];
-        let k = 3 * *slot as usize;
-        out[k..k + 3].copy_from_slice(t);
-        *slot += 1;
-    }
-    out
+    order.into_iter().map(|(_, v)| v).collect()
 }
 
 /// Morton code of each point in the points' bounding box (finite coordinates assumed; a flat
@@ -107,6 +136,18 @@ mod tests {
     }
 
     #[test]
+    fn radix_order_is_a_stable_sort() {
+        let code: Vec<u64> = (0..5000u64)
+            .map(|k| ((k * 7919) % 613) << (k % 50))
+            .collect();
+        let mut expected: Vec<u32> = (0..code.len() as u32).collect();
+        expected.sort_by_key(|&v| (code[v as usize], v));
+        assert_eq!(sorted_by_code(&code), expected);
+        assert_eq!(sorted_by_code(&[0, 0, 0]), vec![0, 1, 2]);
+        assert!(sorted_by_code(&[]).is_empty());
+    }
+
+    #[test]
     fn spatial_numbering_groups_near_points_and_faces_follow() {
         // Two clusters given interleaved: the numbering puts each cluster together.
         let pos: Vec<Point3> = (0..40)
@@ -121,9 +162,9 @@ mod tests {
         seen.sort_unstable();
         assert_eq!(seen, (0..40).collect::<Vec<u32>>());
         assert!((0..40).step_by(2).all(|v| n.work[v] < 20));
-        let (moved, faces) = n.apply(pos.clone(), tris);
+        let (moved, faces) = n.apply(&pos, &tris);
         assert_eq!(moved[n.work[7] as usize], pos[7]);
-        let lows: Vec<u32> = faces.chunks(3).map(|t| *t.iter().min().unwrap()).collect();
+        let lows: Vec<u32> = faces.iter().map(|t| *t.iter().min().unwrap()).collect();
         assert!(lows.windows(2).all(|w| w[0] <= w[1]));
     }
 }

@@ -16,9 +16,14 @@ fn bin(cost: f64) -> Option<usize> {
 }
 
 /// An upper bound, within 6.25 %, of the `n`-th smallest (from 0) of `costs`; infinite when
-/// there are not more than `n` costs.
-pub(super) fn cost_at_rank(costs: impl Iterator<Item = f64> + Clone, n: usize) -> f64 {
-    let mut count = vec![0u32; BINS];
+/// there are not more than `n` costs. `count` is scratch space for the histogram.
+pub(super) fn cost_at_rank(
+    costs: impl Iterator<Item = f64>,
+    n: usize,
+    count: &mut Vec<u32>,
+) -> f64 {
+    count.clear();
+    count.resize(BINS, 0);
     for c in costs.filter_map(bin) {
         count[c] += 1;
     }
@@ -55,7 +60,7 @@ mod tests {
             f64::NAN,
             f64::INFINITY,
         ];
-        let at = |n| cost_at_rank(costs.iter().copied(), n);
+        let at = |n| cost_at_rank(costs.iter().copied(), n, &mut Vec::new());
         assert!(at(0) > 0.0 && at(0) < 1e-300);
         assert!(at(1) >= 1e-30 && at(1) < 1.07e-30);
         assert!(at(2) >= 2.0 && at(2) < 2.13);
