@@ -180,7 +180,27 @@ impl Stencils {
         for &(j, w) in &self.entries {
             diag[j as usize] += w * w;
         }
-        let fair = fair.map(|(f, points, lambda)| (f, points, lambda, median(&diag)));
+        let typical = median(&diag);
+        // A control point that the data barely reaches (support below WEAK_SUPPORT of the
+        // median) and no fairness holds is all but free in the least-squares problem, and one
+        // CG solve can throw it anywhere; a ridge on its move keeps it where it is unless the
+        // data pulls it. (Where fairness holds it, the ridge would only slow the fairness.)
+        let held = |j: usize| fair.is_some_and(|(_, _, lambda)| lambda.get(j) > Some(&0.0));
+        let ridge: Vec<f64> = diag
+            .iter()
+            .enumerate()
+            .map(|(j, &d)| {
+                if d < WEAK_SUPPORT * typical && !held(j) {
+                    WEAK_SUPPORT * typical
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        for (d, r) in diag.iter_mut().zip(&ridge) {
+            *d += r;
+        }
+        let fair = fair.map(|(f, points, lambda)| (f, points, lambda, typical));
         if let Some((_, _, lambda, scale)) = fair {
             for (d, l) in diag.iter_mut().zip(lambda) {
                 *d += l * scale;
@@ -212,6 +232,9 @@ impl Stencils {
         let mut ap = vec![Vec3::ZERO; n];
         for _ in 0..steps {
             self.apply_normal(&p, metric, &mut ap);
+            for ((a, q), r) in ap.iter_mut().zip(&p).zip(&ridge) {
+                *a += *q * *r;
+            }
             if let Some((f, _, lambda, scale)) = fair {
                 f.add_normal(&p, lambda, scale, &mut ap);
             }
@@ -238,6 +261,10 @@ impl Stencils {
         x
     }
 }
+
+/// Support (Σ_i B_ij² over the data) below this share of the median is weak: see
+/// [`Stencils::cg`].
+const WEAK_SUPPORT: f64 = 0.01;
 
 /// The median of `values` (0 for none).
 fn median(values: &[f64]) -> f64 {
