@@ -26,6 +26,13 @@ pub struct FitReport {
     pub e_max_pct: f64,
     /// Final E_rms, %.
     pub e_rms_pct: f64,
+    /// Final E_back max (surface → data), %; absent where not measured. Also for a fit that
+    /// converged before its first iteration, which has no `history` row to carry it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub e_back_max_pct: Option<f64>,
+    /// Final 99th percentile of E_back, %.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub e_back_p99_pct: Option<f64>,
     /// Whether every tolerance was met.
     pub converged: bool,
     /// How the fit ended (or `running`).
@@ -77,6 +84,8 @@ impl FitReport {
             e_avg_pct: stats.e_avg_pct,
             e_max_pct: stats.e_max_pct,
             e_rms_pct: stats.e_rms_pct,
+            e_back_max_pct: fitter.state().back().map(|b| b.max_pct),
+            e_back_p99_pct: fitter.state().back().map(|b| b.p99_pct),
             converged: log.status() == FitStatus::Converged,
             status: log.status(),
             within_tolerance_pct: fitter

@@ -380,8 +380,11 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
     let within = report.within_tolerance_pct.map_or(String::new(), |w| {
         format!(" ({w:.2}% of points within E_max tolerance)")
     });
+    let back = report
+        .e_back_max_pct
+        .map_or(String::new(), |b| format!(", E_back {b:.4}%"));
     outln!(
-        "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%{}, precompute {:.2} s, fit {:.2} s, total {:.2} s",
+        "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%{}{}, precompute {:.2} s, fit {:.2} s, total {:.2} s",
         report.scheme,
         match report.status {
             FitStatus::Converged => "converged",
@@ -395,6 +398,7 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
         report.e_max_pct,
         report.e_rms_pct,
         within,
+        back,
         report.precompute_s,
         report.fit_s,
         report.total_s
