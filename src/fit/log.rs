@@ -137,8 +137,8 @@ impl FitLog {
 
     /// What happened to the data before the first iteration, one line each for people (the
     /// CLI prints them, the page shows them): the strays left out, the reconstruction of bare
-    /// points, the repair of
-    /// the mesh, and a simplification that relaxed its guards or stopped above its target.
+    /// points, the repair of the mesh, and a simplification that relaxed its guards or stopped
+    /// above its target.
     pub fn intake_notes(&self) -> Vec<String> {
         let mut notes: Vec<String> = self.strays.iter().map(StrayPoints::note).collect();
         if let Some(r) = &self.reconstruction {

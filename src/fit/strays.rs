@@ -2,7 +2,7 @@
 //! the bounding-box diagonal is taken, since every tolerance is a percentage of it.
 
 use super::FitData;
-use crate::geom::{find_strays, Point3};
+use crate::geom::find_strays;
 use crate::io::RangeGrid;
 use crate::mesh::{PolyMesh, NONE};
 use serde::Serialize;
@@ -12,9 +12,6 @@ use serde::Serialize;
 pub struct StrayPoints {
     /// Their indices among the data's points, in order.
     pub indices: Vec<u32>,
-    /// Their positions.
-    #[serde(skip)]
-    pub positions: Vec<Point3>,
 }
 
 impl StrayPoints {
@@ -27,15 +24,9 @@ impl StrayPoints {
             .take(SHOWN)
             .map(u32::to_string)
             .collect();
-        let more = if self.indices.len() > SHOWN {
-            ", …"
-        } else {
-            ""
-        };
-        let (n, s) = match self.indices.len() {
-            1 => (1, ""),
-            n => (n, "s"),
-        };
+        let n = self.indices.len();
+        let more = if n > SHOWN { ", …" } else { "" };
+        let s = if n == 1 { "" } else { "s" };
         format!(
             "left out {n} stray point{s} far from the rest (point{s} {}{more})",
             list.join(", ")
@@ -56,8 +47,7 @@ impl WithoutStrays {
     /// `data` without its strays, or `None` when it has none. Faces through a stray are
     /// dropped, its range-grid cell emptied, and polylines skip it.
     pub(super) fn of(data: &FitData) -> Option<WithoutStrays> {
-        let positions = data.mesh.positions();
-        let indices = find_strays(positions);
+        let indices = find_strays(data.mesh.positions());
         if indices.is_empty() {
             return None;
         }
@@ -72,15 +62,11 @@ impl WithoutStrays {
                     .collect()
             })
             .collect();
-        let strays = StrayPoints {
-            positions: indices.iter().map(|&i| positions[i as usize]).collect(),
-            indices,
-        };
         Some(WithoutStrays {
             mesh,
             grid: data.grid.map(|g| g.renumbered(&new_index)),
             polylines,
-            strays,
+            strays: StrayPoints { indices },
         })
     }
 
@@ -98,6 +84,7 @@ impl WithoutStrays {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::Point3;
 
     #[test]
     fn strays_leave_the_mesh_the_grid_and_the_polylines() {

@@ -10,7 +10,8 @@ use super::Point3;
 /// The largest coordinate magnitude geofit takes: the largest an `f32` holds (3.4e38), since
 /// the page renders, and GLB and STL store, positions as `f32`. Inside it the fit's maths stays
 /// clear of `f64` overflow: QEM's quadrics and their determinants reach sixth powers of the
-/// data's size; the bundled sample fits alike scaled by 1e-30 and by 1e45.
+/// data's size; the bundled sample fits alike scaled by 1e-30 and by 1e30
+/// (`tests/fit_strays.rs`).
 pub const COORDINATE_LIMIT: f64 = f32::MAX as f64;
 
 /// The first point geofit cannot take, and why.

@@ -116,6 +116,19 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
   const problems = [];
   let fitLongTasks = null;
 
+  /** Runs `body` on a fresh page at the start state (nothing edited), closed afterwards. */
+  async function onFreshPage(label, body) {
+    const fresh = await browser.newPage({ viewport: { width: 1100, height: 800 } });
+    try {
+      fresh.on('pageerror', (e) => problems.push(`${label} page error: ${e.message}`));
+      await fresh.goto(page.url());
+      await fresh.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
+      await body(fresh);
+    } finally {
+      await fresh.close();
+    }
+  }
+
   before(async () => {
     const started = await startServer(0);
     server = started.server;
@@ -430,11 +443,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
   test('user files from the corpus fit with no setting touched; repairs are listed', async () => {
     // A fresh page, nothing edited: a dropped file gets the core's defaults (the first
     // sample's preset sets only the scheme), the same as `geofit fit FILE`.
-    const fresh = await browser.newPage({ viewport: { width: 1100, height: 800 } });
-    try {
-      fresh.on('pageerror', (e) => problems.push(`corpus page error: ${e.message}`));
-      await fresh.goto(page.url());
-      await fresh.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
+    await onFreshPage('corpus', async (fresh) => {
       const data = join(ROOT, '..', 'shared', 'data');
       const files = [
         ['corpus/woody.obj', null],
@@ -454,17 +463,11 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
           assert.match(await fresh.textContent('#fit-intake'), repaired);
         }
       }
-    } finally {
-      await fresh.close();
-    }
+    });
   });
 
   test('a stray point is listed, left out of the view and the fit, and the fit converges', async () => {
-    const fresh = await browser.newPage({ viewport: { width: 1100, height: 800 } });
-    try {
-      fresh.on('pageerror', (e) => problems.push(`strays page error: ${e.message}`));
-      await fresh.goto(page.url());
-      await fresh.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
+    await onFreshPage('strays', async (fresh) => {
       assert.equal(await fresh.isHidden('#strays-row'), true, 'the bundled bunny has no strays');
       // The range-scan sample's preset (B-spline surface, 200 initial) must not carry over to
       // a file of the user's: that gets the core's defaults, as `geofit fit FILE` does.
@@ -490,9 +493,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       assert.ok(stats.eMaxPct <= 0.5 && Number.isFinite(stats.eBackMaxPct), JSON.stringify(stats));
       // The diagonal is the bunny's, not the stray's 50 units.
       assert.ok(stats.diagonal < 1, JSON.stringify(stats));
-    } finally {
-      await fresh.close();
-    }
+    });
   });
 
   test('keyboard: arrow keys turn the focused view; every control has a label', async () => {
