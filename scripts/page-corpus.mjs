@@ -1,7 +1,7 @@
 // Drops every mesh of ../shared/data and its corpus on a fresh page (headless chromium,
 // WebGL2), picks each subdivision scheme and touches nothing else, presses Play and prints a
 // Markdown row: file, scheme, status, iterations, control points, E_max %, E_back max %, seconds,
-// page errors. The page's side of `cargo test --release --test corpus` (see README).
+// page errors. The page's side of `cargo test --release --test corpus` (see docs/subdivision.md).
 // Usage: node scripts/page-corpus.mjs   (after bash scripts/build-wasm.sh)
 import { readFileSync, readdirSync } from 'node:fs';
 import { join } from 'node:path';

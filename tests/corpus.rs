@@ -190,7 +190,7 @@ fn every_shared_mesh_and_its_points_fit_with_the_defaults() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
-    // The table of every fit, for the README and the issue notes.
+    // The table of every fit, for docs/subdivision.md and the issue notes.
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("corpus-report.md");
     let header = "| file scheme | status | iterations | control points | E_avg % | E_max % | E_back % | total s |\n|---|---|---|---|---|---|---|---|\n";
     std::fs::write(&out, format!("{header}{table}")).expect("write the table");

@@ -80,7 +80,7 @@ fn every_shared_mesh_simplifies_to_200_and_50() {
             ));
             assert!(dev.max.is_finite() && dev.rms <= dev.max);
             // At 50 vertices two corpus meshes keep one face each that faces more than 120°
-            // from the input nearest to it (cow, beetle: see the README's QEM figures); at 200
+            // from the input nearest to it (cow, beetle: see the QEM figures in docs/subdivision.md); at 200
             // none does.
             let allowed = if target == 50 { 1 } else { 0 };
             assert!(folds.count <= allowed, "{name} -> {target}: {folds:?}");

@@ -3,11 +3,11 @@
 // E_avg 0.1 %, E_max 0.5 %; tolerances chosen so that the fit converges in seconds in headless
 // chromium on 2 cores), then the other schemes on the other bundled samples (B-spline surface on
 // the range scan, B-spline and Chaikin curves on the section), exports, views and the embedding
-// example of the README.
+// example of docs/api.md.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { validateBytes } from 'gltf-validator';
-import { readFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { startServer } from '../../scripts/serve.mjs';
 import { join } from 'node:path';
 import { BACKENDS, ROOT, countPixels, launch, saveArtifact } from './helpers.mjs';
@@ -171,6 +171,12 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     await page.waitForTimeout(1000);
     assert.equal(await fitIter(page), 1);
     assert.equal(await page.evaluate(() => window.geofitFit.history.length), 1);
+    if (backend.name === 'WebGL2') {
+      // The README's picture: the page mid-fit, refreshed by every run of this test (commit it
+      // when the page has changed).
+      mkdirSync(join(ROOT, 'docs', 'images'), { recursive: true });
+      writeFileSync(join(ROOT, 'docs', 'images', 'page-mid-fit.png'), await page.screenshot());
+    }
   });
 
   test('Play converges, E_max is shown under tolerance and equals the API figure', async () => {
@@ -352,10 +358,10 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     assert.match(bytes.toString('latin1'), /B_SPLINE_CURVE_WITH_KNOTS\('[^']*',2,/);
   });
 
-  test('the README embedding example fits and draws the bunny', async () => {
-    const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
+  test('the embedding example of docs/api.md fits and draws the bunny', async () => {
+    const doc = readFileSync(join(ROOT, 'docs', 'api.md'), 'utf8');
     for (const file of ['embed-example.html', 'embed-worker.js']) {
-      assert.ok(readme.includes(readFileSync(join(ROOT, 'www', file), 'utf8')), `README shows www/${file} as it is`);
+      assert.ok(doc.includes(readFileSync(join(ROOT, 'www', file), 'utf8')), `docs/api.md shows www/${file} as it is`);
     }
     const embed = await browser.newPage({ viewport: { width: 800, height: 600 } });
     try {

@@ -18,7 +18,7 @@
 //!
 //! Collapses are made in passes rather than from a priority queue (see the `engine` module).
 //! Measured on one core of a quiet 2-core VM (`bash scripts/bench_qem.sh`, figures in the
-//! README): the Stanford bunny (69,451 triangles) to 612 vertices in 0.076 s, 0.91 M triangles
+//! docs/subdivision.md): the Stanford bunny (69,451 triangles) to 612 vertices in 0.076 s, 0.91 M triangles
 //! per second; the bunny Loop-subdivided three times (4.4 M triangles) in 5.9 s, 0.75 M
 //! triangles per second, the whole process peaking at 175 bytes per input triangle.
 //!
@@ -88,7 +88,7 @@ pub struct SimplifyOptions {
     /// Largest valence (number of neighbours) a collapse may give a vertex, unless one of the
     /// edge's ends already had more: subdivision evaluates a patch from at most 64 control
     /// points, which three corners of valence about 20 already need. Default 16 (never more
-    /// than 3 above the largest valence an input ends with; see the README's QEM figures).
+    /// than 3 above the largest valence an input ends with; see the QEM figures in docs/subdivision.md).
     pub max_valence: usize,
 }
 
