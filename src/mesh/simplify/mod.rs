@@ -17,9 +17,9 @@
 //! target below it gives the floor, with [`SimplifyReport::floor_note`] saying so.
 //!
 //! Collapses are made in passes rather than from a priority queue (see the `engine` module).
-//! Measured on one core of a quiet 2-core VM (`bash scripts/bench_qem.sh`, figures in the
-//! docs/subdivision.md): the Stanford bunny (69,451 triangles) to 612 vertices in 0.076 s, 0.91 M triangles
-//! per second; the bunny Loop-subdivided three times (4.4 M triangles) in 5.9 s, 0.75 M
+//! Measured on one core of a quiet 2-core VM (`bash scripts/bench_qem.sh`, figures in
+//! docs/subdivision.md): the Stanford bunny (69,451 triangles) to 612 vertices in 0.076 s,
+//! 0.91 M triangles per second; the bunny Loop-subdivided three times (4.4 M triangles) in 5.9 s, 0.75 M
 //! triangles per second, the whole process peaking at 175 bytes per input triangle.
 //!
 //! ```
