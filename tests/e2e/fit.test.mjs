@@ -10,7 +10,7 @@ import { validateBytes } from 'gltf-validator';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { startServer } from '../../scripts/serve.mjs';
 import { join } from 'node:path';
-import { BACKENDS, ROOT, countPixels, launch, saveArtifact } from './helpers.mjs';
+import { BACKENDS, ROOT, countPixels, launch, loadGlbWithThree, saveArtifact } from './helpers.mjs';
 
 const TIMEOUT_MS = 180_000;
 const TOL_MAX = 0.5;
@@ -249,6 +249,11 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       if (what === 'glb') {
         const result = await validateBytes(new Uint8Array(bytes));
         assert.equal(result.issues.numErrors, 0, JSON.stringify(result.issues.messages.slice(0, 5)));
+        const three = await loadGlbWithThree(page, bytes);
+        assert.equal(three.meshes, 1, JSON.stringify(three));
+        assert.equal(three.triangles, counts.triangles, 'three.js sees the triangles loadFile sees');
+        assert.ok(three.colors && three.deviation, `COLOR_0 and _DEVIATION reach three.js: ${JSON.stringify(three)}`);
+        assert.equal(three.userData.scheme, 'loop', `the fit's figures as userData: ${JSON.stringify(three.userData).slice(0, 200)}`);
       }
     }
     assert.ok(await page.isDisabled('[data-export="iges"]'), 'no IGES for a subdivision surface');

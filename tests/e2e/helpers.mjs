@@ -1,6 +1,6 @@
 // Shared set-up of the browser tests: Debian's chromium (never a downloaded browser), its flags
 // per graphics backend, the shared scans, the test-artifacts/ folder and canvas pixel counting.
-import { existsSync, mkdirSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -84,4 +84,45 @@ export async function countPixels(page, selector, file, classes) {
     for (const [name, test] of entries) if (test(r, g, b, corner)) counts[name] += 1;
   }
   return counts;
+}
+
+/**
+ * Serves the npm package three (node_modules/three) to `page` under /three/, with its bare
+ * `from 'three'` imports pointed at the module build, so a test can import three.js loaders
+ * without a bundler or an import map.
+ */
+export async function routeThree(page) {
+  const base = join(ROOT, 'node_modules', 'three');
+  await page.route(/\/three\//, async (route) => {
+    const rel = new URL(route.request().url()).pathname.replace(/^.*?\/three\//, '');
+    const file = join(base, rel);
+    if (!file.startsWith(base) || !existsSync(file)) return route.fulfill({ status: 404, body: '' });
+    const body = readFileSync(file, 'utf8').replaceAll("from 'three'", "from '/three/build/three.module.js'");
+    return route.fulfill({ status: 200, contentType: 'text/javascript', body });
+  });
+}
+
+/**
+ * Parses `bytes` (a GLB) with three.js's GLTFLoader in `page` and summarises the scene: meshes,
+ * vertices, triangles, whether they carry vertex colours and the custom _DEVIATION attribute, and
+ * the scene's userData (the GLB's extras).
+ */
+export async function loadGlbWithThree(page, bytes) {
+  await routeThree(page);
+  return page.evaluate(async (b64) => {
+    const { GLTFLoader } = await import('/three/examples/jsm/loaders/GLTFLoader.js');
+    const buffer = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0)).buffer;
+    const gltf = await new GLTFLoader().parseAsync(buffer, '');
+    const out = { meshes: 0, vertices: 0, triangles: 0, colors: true, deviation: true, userData: gltf.scene.userData };
+    gltf.scene.traverse((o) => {
+      if (!o.isMesh) return;
+      const g = o.geometry;
+      out.meshes += 1;
+      out.vertices += g.attributes.position.count;
+      out.triangles += (g.index ? g.index.count : g.attributes.position.count) / 3;
+      out.colors &&= Boolean(g.attributes.color);
+      out.deviation &&= Boolean(g.attributes._deviation);
+    });
+    return out;
+  }, Buffer.from(bytes).toString('base64'));
 }

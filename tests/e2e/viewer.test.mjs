@@ -3,6 +3,7 @@
 // test-artifacts/.
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { startServer } from '../../scripts/serve.mjs';
 import { BACKENDS, ROOT, countPixels, dataDir, launch, saveArtifact } from './helpers.mjs';
@@ -94,6 +95,34 @@ for (const backend of BACKENDS) {
       assert.equal(await page.isHidden('#error'), true);
       const px = await canvasPixels(page, `bun000-${backend.name}.png`);
       assert.ok(px.drawn > 0.05 * px.total, `only ${px.drawn} of ${px.total} pixels drawn`);
+    });
+
+    test('every scanner format of tests/data/formats opens through the file input with its counts', async () => {
+      const dir = join(ROOT, 'tests', 'data', 'formats');
+      const expected = JSON.parse(readFileSync(join(dir, 'expected.json'), 'utf8'));
+      const seen = new Set();
+      for (const [file, want] of Object.entries(expected)) {
+        const frames = await framesDrawn(page);
+        await page.setInputFiles('#file', join(dir, file));
+        await page.waitForFunction(
+          ([name, points]) =>
+            document.getElementById('file-name').textContent === name &&
+            document.getElementById('num-points').textContent === points,
+          [file, want.points.toLocaleString('en-US')],
+          { timeout: TIMEOUT_MS },
+        );
+        await nextFrame(page, frames);
+        assert.equal(await page.isHidden('#error'), true, `${file}: no error shown`);
+        assert.equal(await page.textContent('#num-triangles'), want.triangles.toLocaleString('en-US'), `${file}: triangles`);
+        const px = await canvasPixels(page, `format-${file}-${backend.name}.png`);
+        // Something is drawn: a few hundred points, or two registered scans far apart, cover a
+        // few hundred pixels only.
+        assert.ok(px.drawn > 100, `${file}: only ${px.drawn} of ${px.total} pixels drawn`);
+        seen.add(file.split('.').pop());
+      }
+      for (const ext of ['e57', 'las', 'laz', 'pcd', 'ptx', 'pts', 'gltf', 'glb']) {
+        assert.ok(seen.has(ext), `a .${ext} sample was opened`);
+      }
     });
 
     test('a corrupt file shows an error and the page keeps working', async () => {
