@@ -94,7 +94,9 @@ fn table() -> String {
 
 #[test]
 fn docs_options_table_is_the_cores() {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("docs").join("options.md");
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("docs")
+        .join("options.md");
     let doc = std::fs::read_to_string(&path).expect("docs/options.md");
     let (Some(a), Some(b)) = (doc.find(BEGIN), doc.find(END)) else {
         panic!("docs/options.md lacks the options-table markers {BEGIN:?} … {END:?}");

@@ -45,6 +45,14 @@ pub enum MeshError {
         /// What overflowed.
         what: &'static str,
     },
+    /// An option of a mesh operation is out of its range.
+    #[error("option {name}: {reason}")]
+    InvalidOption {
+        /// The option.
+        name: &'static str,
+        /// Why it is rejected.
+        reason: String,
+    },
 }
 
 impl From<crate::geom::BadCoordinate> for MeshError {

@@ -2,6 +2,7 @@
 //! subdivision and fitting work on; their repair on intake and their QEM simplification.
 
 mod error;
+mod features;
 mod halfedge;
 mod poly;
 mod repair;
@@ -9,6 +10,7 @@ mod simplify;
 mod validate;
 
 pub use error::MeshError;
+pub use features::{detect_features, FeatureLine, FeatureOptions, Features};
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
 pub use repair::{repair, repair_with, Components, Found, RepairOptions, RepairReport, Repaired};

@@ -20,7 +20,9 @@ pub struct Args {
 /// formats that define their unit (E57, glTF/GLB: metres) add `unit_to_metres`. A mesh adds
 /// `repairs`: what the repair every fit starts with would change ([`geofit::mesh::RepairReport`]:
 /// counts per kind, the first few indices of each, and a one-line `summary`). Points a fit would
-/// leave out as strays ([`geofit::geom::find_strays`]) add `strays` (`count`, `first`).
+/// leave out as strays ([`geofit::geom::find_strays`]) add `strays` (`count`, `first`). A mesh
+/// also adds `features`: the sharp creases [`geofit::mesh::detect_features`] finds on the
+/// repaired mesh with its default angle (counts, total length, and the first few corners).
 pub fn run(args: Args) -> Result<(), String> {
     let loaded = read_input(&args.file)?;
     let mesh = &loaded.mesh;
@@ -46,6 +48,7 @@ pub fn run(args: Args) -> Result<(), String> {
         let repaired =
             geofit::mesh::repair(mesh).map_err(|e| format!("{}: {e}", args.file.display()))?;
         report["repairs"] = serde_json::to_value(&repaired.report).map_err(|e| e.to_string())?;
+        report["features"] = features_json(&repaired.mesh)?;
     }
     let strays = geofit::geom::find_strays(mesh.positions());
     if !strays.is_empty() {
@@ -61,4 +64,28 @@ pub fn run(args: Args) -> Result<(), String> {
         report["dimension"] = 2.into();
     }
     print_json(&report, args.json)
+}
+
+/// The `features` object of `geofit info`: crease edges, lines, their length (model units and %
+/// of the bounding-box diagonal), corners and dart ends, at the default crease angle.
+fn features_json(mesh: &geofit::mesh::PolyMesh) -> Result<serde_json::Value, String> {
+    let options = geofit::mesh::FeatureOptions::default();
+    let found = geofit::mesh::detect_features(mesh, &options).map_err(|e| e.to_string())?;
+    let diagonal = mesh.bbox().map_or(0.0, |b| b.diagonal());
+    let pct = if diagonal > 0.0 {
+        100.0 * found.total_length / diagonal
+    } else {
+        0.0
+    };
+    Ok(serde_json::json!({
+        "angle_deg": options.angle_deg,
+        "crease_edges": found.edges.len(),
+        "lines": found.lines.len(),
+        "length": found.total_length,
+        "length_diagonals": pct / 100.0,
+        "corners": found.corners.len(),
+        "darts": found.darts.len(),
+        "first_corners": &found.corners[..found.corners.len().min(5)],
+        "summary": found.summary(),
+    }))
 }
