@@ -354,7 +354,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
 
   test('the README embedding example fits and draws the bunny', async () => {
     const readme = readFileSync(join(ROOT, 'README.md'), 'utf8');
-    for (const file of ['embed-example.html', 'embed-worker.js']) {
+    for (const file of ['embed-example.html']) {
       assert.ok(readme.includes(readFileSync(join(ROOT, 'www', file), 'utf8')), `README shows www/${file} as it is`);
     }
     const embed = await browser.newPage({ viewport: { width: 800, height: 600 } });
