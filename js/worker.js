@@ -84,7 +84,7 @@ const ready = init();
 onmessage = async (/** @type {MessageEvent<WorkerRequest>} */ event) => {
   try {
     await ready;
-    const unknown = event.data.exports.filter((e) => !(e in EXPORTS));
+    const unknown = event.data.exports.filter((e) => !Object.hasOwn(EXPORTS, e));
     if (unknown.length) throw new Error(`unknown export '${unknown[0]}' (one of ${Object.keys(EXPORTS).join(', ')})`);
     fit(event.data);
   } catch (e) {
