@@ -35,18 +35,6 @@ function buffers(...meshes) {
   return meshes.flatMap((m) => [m.positions.buffer, m.normals.buffer, m.indices.buffer, m.edges.buffer]);
 }
 
-/** The exports by name, as `exportsFor(scheme)` lists them. */
-const EXPORTS = {
-  /** @param {Fitter} f */ cage: (f) => f.exportCage(),
-  /** @param {Fitter} f */ obj: (f) => f.exportObj(),
-  /** @param {Fitter} f */ ply: (f) => f.exportPly(),
-  /** @param {Fitter} f */ stl: (f) => f.exportStl(),
-  /** @param {Fitter} f */ glb: (f) => f.exportGlb(),
-  /** @param {Fitter} f */ iges: (f) => f.exportIges(),
-  /** @param {Fitter} f */ step: (f) => f.exportStep(),
-  /** @param {Fitter} f */ json: (f) => new TextEncoder().encode(f.reportJson()),
-};
-
 /**
  * Fits `request` to the end, posting frames; the fitter is freed whatever happens.
  * @param {WorkerRequest} request
@@ -70,7 +58,7 @@ function fit({ bytes, name, spec, sliceMs, resolution, exports }) {
     const control = meshData(fitter.controlMesh());
     /** @type {Partial<Record<import('./geofit.js').ExportName, Uint8Array>>} */
     const files = {};
-    for (const what of exports) files[what] = EXPORTS[what](fitter);
+    for (const what of exports) files[what] = fitter.exportAs(what);
     const report = JSON.parse(fitter.reportJson());
     const transfer = [...buffers(limit, control), ...Object.values(files).map((b) => b.buffer)];
     post({ type: 'done', result: { stats, report, limit, control, exports: files } }, transfer);
@@ -84,8 +72,6 @@ const ready = init();
 onmessage = async (/** @type {MessageEvent<WorkerRequest>} */ event) => {
   try {
     await ready;
-    const unknown = event.data.exports.filter((e) => !Object.hasOwn(EXPORTS, e));
-    if (unknown.length) throw new Error(`unknown export '${unknown[0]}' (one of ${Object.keys(EXPORTS).join(', ')})`);
     fit(event.data);
   } catch (e) {
     post({ type: 'error', message: String(/** @type {Error} */ (e)?.message ?? e) });

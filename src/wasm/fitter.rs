@@ -423,6 +423,30 @@ impl Fitter {
         Ok(export::step_of(self.fit.as_ref(), "geofit")?.into_bytes())
     }
 
+    /// The export named `what` (one of `exportsFor(scheme)`: `cage`, `obj`, `ply`, `stl`, `glb`,
+    /// `iges`, `step`, `json`) as bytes, as the `export*` method of that name gives it; the
+    /// workers export by name through this one table. Throws on another name, or when the
+    /// scheme has no such export.
+    #[wasm_bindgen(js_name = exportAs)]
+    pub fn export_as(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "ExportName")] what: &str,
+    ) -> Result<Vec<u8>, JsError> {
+        match what {
+            "cage" => self.export_cage(),
+            "obj" => self.export_obj(),
+            "ply" => self.export_ply(),
+            "stl" => self.export_stl(),
+            "glb" => self.export_glb(),
+            "iges" => self.export_iges(),
+            "step" => self.export_step(),
+            "json" => Ok(self.report_json()?.into_bytes()),
+            _ => Err(JsError::new(&format!(
+                "unknown export '{what}': one of cage, obj, ply, stl, glb, iges, step, json"
+            ))),
+        }
+    }
+
     /// What happened to the data before the first iteration, one line each ("repaired: 3
     /// non-manifold vertices split", "reconstructed open surface (delaunay): ...").
     #[wasm_bindgen(js_name = intakeNotes)]

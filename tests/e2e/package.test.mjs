@@ -21,7 +21,7 @@ const run = (cmd, args, cwd) => execFileSync(cmd, args, { cwd, encoding: 'utf8',
 
 // The page: fits through the package's worker entry, and calls the main entry for the defaults.
 const MAIN_JS = `
-import init, { defaultSpec } from 'geofit';
+import init, { Fitter, defaultSpec, loadFile } from 'geofit';
 import { fitInWorker } from 'geofit/worker';
 
 const file = (name) => fetch(name).then((r) => r.arrayBuffer());
@@ -44,8 +44,19 @@ window.geofit = {
     await new Promise((r) => setTimeout(r, 500));
     return { name: error?.name ?? null, atAbort, later: frames };
   },
-  async error(bytes, name, spec) {
-    return fitInWorker(new TextEncoder().encode(bytes), name, spec).then(() => null, (e) => [e instanceof Error, e.message]);
+  async error(text, name, spec, exports) {
+    const bytes = text === null ? await file(name) : new TextEncoder().encode(text);
+    return fitInWorker(bytes, name, spec, { exports }).then(() => null, (e) => [e instanceof Error, e.message]);
+  },
+  async history(name, spec) {
+    await init();
+    const scan = loadFile(new Uint8Array(await file(name)), name);
+    const fitter = new Fitter(scan, spec);
+    scan.free();
+    fitter.run(60_000);
+    const history = fitter.history();
+    fitter.free();
+    return history;
   },
   async defaults(scheme) {
     await init();
@@ -56,7 +67,7 @@ document.body.dataset.ready = 'yes';
 `;
 const INDEX_HTML = (src) =>
   `<!doctype html><html><head><meta charset="utf-8"><title>geofit package</title></head><body><script type="module" src="${src}"></script></body></html>\n`;
-const SAMPLES = ['bunny.obj', 'bunny-section.xyz'];
+const SAMPLES = ['bunny.obj', 'bunny-section.xyz', 'bun000-points.xyz'];
 
 /** Strips comments, so that only declarations are searched. */
 const code = (dts) => dts.replace(/\/\*[^]*?\*\//g, '').replace(/\/\/.*$/gm, '');
@@ -157,12 +168,19 @@ describe('the npm package', () => {
         const badFile = await page.evaluate(() => window.geofit.error('ply\nformat nonsense\n', 'a.ply', {}));
         assert.equal(badFile[0], true);
         assert.match(badFile[1], /ply/i);
+        const badExport = await page.evaluate(() => window.geofit.error(null, 'bunny-section.xyz', { scheme: 'bspline-curve' }, ['dwg']));
+        assert.deepEqual(badExport, [true, "unknown export 'dwg': one of cage, obj, ply, stl, glb, iges, step, json"]);
 
         if (bundle === 'dist-esbuild') {
           const curve = await page.evaluate(() => window.geofit.fit('bunny-section.xyz', { scheme: 'bspline-curve', method: 'knots' }, []));
           results.stats = fit.stats;
           results.report = fit.report;
           results.curveReport = curve.report;
+          const surface = await page.evaluate(() => window.geofit.fit('bun000-points.xyz', { scheme: 'bspline-surface', maxIter: 2 }, ['step']));
+          assert.ok(surface.report.control_points_u > 0, JSON.stringify(surface.report).slice(0, 300));
+          results.surfaceReport = surface.report;
+          results.history = await page.evaluate(() => window.geofit.history('bunny-section.xyz', { scheme: 'bspline-curve' }));
+          assert.ok(results.history.length > 0);
           results.defaults = await page.evaluate(() => window.geofit.defaults('bspline-surface'));
         }
         assert.deepEqual(problems, []);
@@ -176,11 +194,13 @@ describe('the npm package', () => {
     assert.ok(results.report, 'the esbuild fit ran');
     const lit = (v) => JSON.stringify(v, null, 1);
     writeFileSync(join(app, 'sample.ts'), [
-      "import type { FitReport, FitStats, ResolvedFitSpec } from 'geofit';",
+      "import type { FitReport, FitStats, HistoryEntry, ResolvedFitSpec } from 'geofit';",
       "import type { FitResult } from 'geofit/worker';",
       `export const stats: FitStats = ${lit(results.stats)};`,
       `export const report: FitReport = ${lit(results.report)};`,
       `export const curveReport: FitReport = ${lit(results.curveReport)};`,
+      `export const surfaceReport: FitReport = ${lit(results.surfaceReport)};`,
+      `export const history: HistoryEntry[] = ${lit(results.history)};`,
       `export const defaults: ResolvedFitSpec = ${lit(results.defaults)};`,
       'export type Checked = FitResult;',
       '',
