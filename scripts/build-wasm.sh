@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the browser package: the geofit crate for wasm32, then wasm-bindgen (ES module + TypeScript
-# declarations) into pkg/, then wasm-opt -Oz. Prints the .wasm size, raw and gzipped.
+# declarations) into pkg/, then wasm-opt -Oz, then scripts/package.mjs makes pkg/ the npm package
+# `geofit` (package.json, the worker entry, README). Prints the .wasm size, raw and gzipped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -16,6 +17,7 @@ node_modules/.bin/wasm-opt -Oz \
     --enable-bulk-memory --enable-bulk-memory-opt --enable-multivalue --enable-mutable-globals \
     --enable-nontrapping-float-to-int --enable-reference-types --enable-sign-ext \
     pkg/geofit_bg.wasm -o pkg/geofit_bg.wasm
+node scripts/package.mjs
 
 raw=$(stat -c %s pkg/geofit_bg.wasm)
 gz=$(gzip -9 -c pkg/geofit_bg.wasm | wc -c)

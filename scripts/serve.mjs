@@ -20,8 +20,8 @@ const TYPES = {
   '.svg': 'image/svg+xml',
 };
 
-/** The file a URL path names, or null when it is outside www/ and pkg/. */
-function resolve(urlPath) {
+/** The file a URL path names, or null when it is outside the `served` folders of `root`. */
+function resolve(urlPath, root, served) {
   let path;
   try {
     path = decodeURIComponent(urlPath.split('?')[0]);
@@ -29,17 +29,17 @@ function resolve(urlPath) {
     return null;
   }
   const rel = normalize(path).replace(/^[/\\]+/, '');
-  if (!SERVED.some((dir) => rel === dir || rel.startsWith(dir + sep))) return null;
-  return join(ROOT, rel);
+  if (!served.some((dir) => rel === dir || rel.startsWith(dir + sep))) return null;
+  return join(root, rel);
 }
 
-async function handle(req, res) {
+async function handle(req, res, root, served) {
   if (req.url === '/' || req.url === '/index.html') {
     res.writeHead(302, { Location: '/www/' });
     res.end();
     return;
   }
-  let file = resolve(req.url);
+  let file = resolve(req.url, root, served);
   try {
     if (file && (await stat(file)).isDirectory()) file = join(file, 'index.html');
     if (!file) throw new Error('outside the served folders');
@@ -55,16 +55,19 @@ async function handle(req, res) {
   }
 }
 
-/** Starts the server on 127.0.0.1:`port` (0: any free port); resolves to { server, url }. */
-export function startServer(port = 0) {
+/**
+ * Starts the server on 127.0.0.1:`port` (0: any free port) for the folders `served` of `root`
+ * (the repository's www/ and pkg/ by default); resolves to { server, url } (url: the first folder).
+ */
+export function startServer(port = 0, { root = ROOT, served = SERVED } = {}) {
   return new Promise((resolvePromise, reject) => {
     const server = createServer((req, res) => {
-      handle(req, res).catch(() => res.destroy());
+      handle(req, res, root, served).catch(() => res.destroy());
     });
     server.once('error', reject);
     server.listen(port, '127.0.0.1', () => {
       const { port: actual } = server.address();
-      resolvePromise({ server, url: `http://127.0.0.1:${actual}/www/` });
+      resolvePromise({ server, url: `http://127.0.0.1:${actual}/${served[0]}/` });
     });
   });
 }

@@ -2,7 +2,7 @@
 # Runs every test of geofit: formatting, clippy (native and wasm32), the native tests (unit,
 # integration, doc), the wasm build, the type check of the page's modules against the package's
 # declarations, the browser tests (tests/e2e/*.mjs in Debian chromium, both
-# WebGL2 and WebGPU) and the Python interop tests (tests/interop/*.py). Installs what it needs
+# WebGL2 and WebGPU; package.test.mjs lints, packs, installs and bundles the npm package) and the Python interop tests (tests/interop/*.py). Installs what it needs
 # first; fast when it is already installed. Prints how long each step took.
 set -euo pipefail
 cd "$(dirname "$0")/.."

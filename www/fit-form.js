@@ -50,7 +50,7 @@ export class FitForm {
 
   /** The options of the chosen scheme and method. */
   applicable() {
-    return new Set(optionsFor(this.scheme.value, this.method.value || undefined));
+    return new Set(/** @type {string[]} */ (optionsFor(this.scheme.value, this.method.value || undefined)));
   }
 
   /**
@@ -59,7 +59,7 @@ export class FitForm {
    */
   schemeChanged() {
     const scheme = this.scheme.value;
-    const methods = methodsFor(scheme);
+    const methods = /** @type {string[]} */ (methodsFor(scheme));
     const keep = methods.includes(this.method.value) && this.edited.has('method') ? this.method.value : methods[0];
     this.method.replaceChildren(...methods.map((m) => new Option(METHOD_LABELS[m] ?? m, m)));
     this.method.value = keep;
@@ -87,7 +87,7 @@ export class FitForm {
 
   /** The exports the chosen scheme offers. */
   exports() {
-    return exportsFor(this.scheme.value);
+    return /** @type {string[]} */ (exportsFor(this.scheme.value));
   }
 
   /**

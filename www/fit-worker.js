@@ -86,18 +86,6 @@ function play(gen) {
   if (playing) setTimeout(() => play(gen), 0);
 }
 
-/** The exports, by the names `exportsFor(scheme)` gives. */
-const EXPORTS = {
-  cage: (f) => f.exportCage(),
-  obj: (f) => f.exportObj(),
-  ply: (f) => f.exportPly(),
-  stl: (f) => f.exportStl(),
-  glb: (f) => f.exportGlb(),
-  iges: (f) => f.exportIges(),
-  step: (f) => f.exportStep(),
-  json: (f) => new TextEncoder().encode(f.reportJson()),
-};
-
 const handlers = {
   [MSG.start]({ generation: gen, bytes, name, spec }) {
     handlers[MSG.clear]({ generation: gen });
@@ -133,9 +121,7 @@ const handlers = {
   },
   [MSG.export]({ what }) {
     if (!fitter) throw new Error('nothing is fitted yet');
-    const make = EXPORTS[what];
-    if (!make) throw new Error(`unknown export '${what}'`);
-    const bytes = make(fitter);
+    const bytes = fitter.exportAs(what);
     post({ type: MSG.exported, what, bytes }, [bytes.buffer]);
   },
 };

@@ -7,7 +7,7 @@
 
 /**
  * Page → worker.
- * @typedef {{ type: 'start', generation: number, bytes: Uint8Array, name: string, spec: Object<string, unknown> }} StartMessage
+ * @typedef {{ type: 'start', generation: number, bytes: Uint8Array, name: string, spec: import('../pkg/geofit.js').FitSpec }} StartMessage
  *   Read `bytes` (a file called `name`) and build a fit with the options object `spec` (the
  *   core's FitSpec, camelCase; left-out fields take the core's defaults).
  * @typedef {{ type: 'play' | 'pause' | 'step' }} DriveMessage
@@ -24,7 +24,7 @@
  * @typedef {{ positions: Float32Array, normals: Float32Array, indices: Uint32Array, edges: Uint32Array }} Shape
  * @typedef {{
  *   type: 'frame', kind: 'start' | 'play' | 'pause' | 'step', generation: number, playing: boolean,
- *   stats: Object<string, any>, history: Object<string, any>[], errors: Float32Array,
+ *   stats: import('../pkg/geofit.js').FitStats, history: import('../pkg/geofit.js').HistoryEntry[], errors: Float32Array,
  *   limit: Shape, control: { positions: Float32Array, edges: Uint32Array },
  *   vectors: Float32Array, iso: Float32Array,
  *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array }, notes: string[] },

@@ -38,7 +38,7 @@ fn to_js(value: &impl Serialize) -> Result<JsValue, JsError> {
 /// every default written out, as the core uses it: `{scheme, method, tolAvg, tolMax, ...}`;
 /// `null` where the data decides (`initial` and `maxControl` of subdivision surfaces, `closed`
 /// of curves) or the scheme has no such option. Throws on an unknown name.
-#[wasm_bindgen(js_name = defaultSpec)]
+#[wasm_bindgen(js_name = defaultSpec, unchecked_return_type = "ResolvedFitSpec")]
 pub fn default_spec(scheme: &str, method: Option<String>) -> Result<JsValue, JsError> {
     let (scheme, method) = scheme_and_method(scheme, method)?;
     to_js(&FitSpec::defaults_with(scheme, method))
@@ -56,7 +56,7 @@ fn scheme_and_method(scheme: &str, method: Option<String>) -> Result<(Scheme, Me
 
 /// The names of the options that take part in a fit of `scheme` by `method` (the scheme's
 /// default method when `method` is left out). Throws on an unknown name.
-#[wasm_bindgen(js_name = optionsFor)]
+#[wasm_bindgen(js_name = optionsFor, unchecked_return_type = "(keyof FitSpec)[]")]
 pub fn options_for(scheme: &str, method: Option<String>) -> Result<Vec<String>, JsError> {
     let (scheme, method) = scheme_and_method(scheme, method)?;
     Ok(FitSpec::options_for(scheme, method)
@@ -67,7 +67,7 @@ pub fn options_for(scheme: &str, method: Option<String>) -> Result<Vec<String>, 
 
 /// The exports a fit of `scheme` offers: `cage`, `json` always; `obj`, `ply`, `stl` for
 /// surfaces; `iges`, `step` for B-splines. Throws on an unknown scheme name.
-#[wasm_bindgen(js_name = exportsFor)]
+#[wasm_bindgen(js_name = exportsFor, unchecked_return_type = "ExportName[]")]
 pub fn exports_for(scheme: &str) -> Result<Vec<String>, JsError> {
     let scheme: Scheme = scheme.parse().map_err(|e: String| JsError::new(&e))?;
     Ok(export::exports_for(scheme)
@@ -77,7 +77,7 @@ pub fn exports_for(scheme: &str) -> Result<Vec<String>, JsError> {
 }
 
 /// The methods of `scheme`, its default first.
-#[wasm_bindgen(js_name = methodsFor)]
+#[wasm_bindgen(js_name = methodsFor, unchecked_return_type = "Method[]")]
 pub fn methods_for(scheme: &str) -> Result<Vec<String>, JsError> {
     let scheme: Scheme = scheme.parse().map_err(|e: String| JsError::new(&e))?;
     Ok(scheme
@@ -145,6 +145,9 @@ impl From<&IterationRecord> for JsRecord {
 /// A shape for drawing: f32 positions (and smooth normals), u32 triangle indices, and the
 /// polygon edges (index pairs) of the mesh before triangulation, or the segments of a polyline
 /// (then there are no triangles).
+///
+/// Holds WebAssembly memory until `free()` is called, or the scope of a `using` declaration
+/// ends (`[Symbol.dispose]()` is `free()`); the garbage collector does not free it in time.
 #[wasm_bindgen]
 #[derive(Clone)]
 pub struct MeshArrays {
@@ -224,6 +227,9 @@ impl MeshArrays {
 /// apply), builds the initial control net (bare points are first reconstructed into a mesh
 /// for the subdivision schemes) and the first foot points; then `step()` or `run(budgetMs)`
 /// iterate. Tolerances are % of the bounding-box diagonal.
+///
+/// Holds WebAssembly memory until `free()` is called, or the scope of a `using` declaration
+/// ends (`[Symbol.dispose]()` is `free()`); the garbage collector does not free it in time.
 #[wasm_bindgen]
 pub struct Fitter {
     fit: Box<dyn CoreFitter>,
@@ -237,7 +243,10 @@ impl Fitter {
     /// Builds a fitter of `scan`. Throws on a bad option (naming it) or when the scan cannot be
     /// fitted by the scheme (no faces to make a control mesh from, too few points, ...).
     #[wasm_bindgen(constructor)]
-    pub fn new(scan: &LoadedScan, options: JsValue) -> Result<Fitter, JsError> {
+    pub fn new(
+        scan: &LoadedScan,
+        #[wasm_bindgen(unchecked_param_type = "FitSpec | null | undefined")] options: JsValue,
+    ) -> Result<Fitter, JsError> {
         let spec = spec_from_js(options)?;
         let fit = spec.build(&scan.fit_data())?;
         let initial = MeshArrays::of(&fit.control_shape());
@@ -249,6 +258,7 @@ impl Fitter {
     }
 
     /// Runs one iteration (unless the fit has already stopped) and returns the statistics.
+    #[wasm_bindgen(unchecked_return_type = "FitStats")]
     pub fn step(&mut self) -> Result<JsValue, JsError> {
         self.fit.step()?;
         self.stats()
@@ -256,6 +266,7 @@ impl Fitter {
 
     /// Iterates until the fit stops or `budget_ms` milliseconds are spent (at least one
     /// iteration while running); returns the statistics.
+    #[wasm_bindgen(unchecked_return_type = "FitStats")]
     pub fn run(&mut self, budget_ms: f64) -> Result<JsValue, JsError> {
         let start = Instant::now();
         while self.fit.status() == FitStatus::Running {
@@ -272,6 +283,7 @@ impl Fitter {
     /// current errors (in % of the diagonal and model units), the last iteration's time and
     /// flags, and the tolerances in force (`null` where none); status is 'running',
     /// 'converged', 'max_iterations' or 'stalled'.
+    #[wasm_bindgen(unchecked_return_type = "FitStats")]
     pub fn stats(&self) -> Result<JsValue, JsError> {
         let f = self.fit.as_ref();
         let s = f.stats();
@@ -302,6 +314,7 @@ impl Fitter {
     }
 
     /// One `{iter, controlPoints, eAvgPct, eMaxPct, eRmsPct, ms, refined}` per iteration so far.
+    #[wasm_bindgen(unchecked_return_type = "HistoryEntry[]")]
     pub fn history(&self) -> Result<JsValue, JsError> {
         let records: Vec<JsRecord> = self.fit.history().iter().map(JsRecord::from).collect();
         to_js(&records)
@@ -408,6 +421,30 @@ impl Fitter {
     #[wasm_bindgen(js_name = exportStep)]
     pub fn export_step(&self) -> Result<Vec<u8>, JsError> {
         Ok(export::step_of(self.fit.as_ref(), "geofit")?.into_bytes())
+    }
+
+    /// The export named `what` (one of `exportsFor(scheme)`: `cage`, `obj`, `ply`, `stl`, `glb`,
+    /// `iges`, `step`, `json`) as bytes, as the `export*` method of that name gives it; the
+    /// workers export by name through this one table. Throws on another name, or when the
+    /// scheme has no such export.
+    #[wasm_bindgen(js_name = exportAs)]
+    pub fn export_as(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "ExportName")] what: &str,
+    ) -> Result<Vec<u8>, JsError> {
+        match what {
+            "cage" => self.export_cage(),
+            "obj" => self.export_obj(),
+            "ply" => self.export_ply(),
+            "stl" => self.export_stl(),
+            "glb" => self.export_glb(),
+            "iges" => self.export_iges(),
+            "step" => self.export_step(),
+            "json" => Ok(self.report_json()?.into_bytes()),
+            _ => Err(JsError::new(&format!(
+                "unknown export '{what}': one of cage, obj, ply, stl, glb, iges, step, json"
+            ))),
+        }
     }
 
     /// What happened to the data before the first iteration, one line each ("repaired: 3

@@ -12,6 +12,12 @@ pub use viewer::Viewer;
 
 use wasm_bindgen::prelude::wasm_bindgen;
 
+/// The TypeScript interfaces of the plain objects the bindings take and give (`FitSpec`,
+/// `FitStats`, `HistoryEntry`, `FitReport`, ...), written once in `types.d.ts` and copied into
+/// `geofit.d.ts`; the functions name them with `unchecked_param_type` / `unchecked_return_type`.
+#[wasm_bindgen(typescript_custom_section)]
+const TYPES: &str = include_str!("types.d.ts");
+
 /// Runs once when the module is instantiated: panics (which no code path relies on) at least
 /// reach the console with their message.
 #[wasm_bindgen(start)]

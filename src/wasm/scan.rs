@@ -10,6 +10,9 @@ use wasm_bindgen::prelude::*;
 /// from the rest ([`crate::geom::find_strays`]), which a fit leaves out, are left out of the
 /// bounding box and the draw buffers too, so that the view frames the object; `strays` lists
 /// them.
+///
+/// Holds WebAssembly memory until `free()` is called, or the scope of a `using` declaration
+/// ends (`[Symbol.dispose]()` is `free()`); the garbage collector does not free it in time.
 #[wasm_bindgen]
 pub struct LoadedScan {
     file: LoadedFile,
@@ -47,8 +50,8 @@ impl LoadedScan {
 
 #[wasm_bindgen]
 impl LoadedScan {
-    /// The format the file was parsed as: "ply", "obj", "stl" or "xyz".
-    #[wasm_bindgen(getter)]
+    /// The format the file was parsed as, in lower case ("ply", "obj", "e57", ...).
+    #[wasm_bindgen(getter, unchecked_return_type = "FileFormat")]
     pub fn format(&self) -> Result<JsValue, JsError> {
         Ok(serde_wasm_bindgen::to_value(&self.file.format)?)
     }

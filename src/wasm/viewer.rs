@@ -6,6 +6,9 @@ use wasm_bindgen::prelude::*;
 /// Draws points, a triangle mesh and line sets on a canvas with WebGPU or WebGL2.
 ///
 /// Data may be replaced every frame; nothing is drawn until `render()` is called.
+///
+/// Holds WebAssembly memory until `free()` is called, or the scope of a `using` declaration
+/// ends (`[Symbol.dispose]()` is `free()`); the garbage collector does not free it in time.
 #[wasm_bindgen]
 pub struct Viewer {
     renderer: Renderer,

@@ -365,7 +365,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
 
   test('the embedding example of docs/api.md fits and draws the bunny', async () => {
     const doc = readFileSync(join(ROOT, 'docs', 'api.md'), 'utf8');
-    for (const file of ['embed-example.html', 'embed-worker.js']) {
+    for (const file of ['embed-example.html']) {
       assert.ok(doc.includes(readFileSync(join(ROOT, 'www', file), 'utf8')), `docs/api.md shows www/${file} as it is`);
     }
     const embed = await browser.newPage({ viewport: { width: 800, height: 600 } });

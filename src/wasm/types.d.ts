@@ -1,0 +1,215 @@
+// The shapes of the plain objects the bindings take and give (options, statistics, history,
+// report, file format), spelt as serde writes them: the JavaScript API's objects in camelCase,
+// the fit report (the CLI's `--json`) in snake_case. wasm-bindgen copies this file into
+// pkg/geofit.d.ts (src/wasm/mod.rs); tests/e2e/package.test.mjs type-checks real outputs
+// against it, so a field renamed in Rust fails there.
+
+/** What is fitted. `bspline` is accepted as another name of `bspline-surface`. */
+export type Scheme =
+  | 'loop' | 'catmull-clark' | 'doo-sabin' | 'bspline-surface' | 'bspline-curve' | 'chaikin-curve';
+/** How control points are found (`methodsFor(scheme)` lists a scheme's, its default first). */
+export type Method = 'geometric' | 'least-squares' | 'knots';
+/** How a fit stands: still iterating, or why it stopped. */
+export type FitStatus = 'running' | 'converged' | 'max_iterations' | 'stalled';
+/** The exports of a fit; `exportsFor(scheme)` says which a scheme offers. */
+export type ExportName = 'cage' | 'json' | 'obj' | 'ply' | 'stl' | 'glb' | 'iges' | 'step';
+/** The file formats `loadFile` reads. */
+export type FileFormat =
+  | 'ply' | 'obj' | 'stl' | 'xyz' | 'e57' | 'las' | 'laz' | 'pcd' | 'ptx' | 'gltf' | 'glb';
+
+/**
+ * The options of a fit (the core's `FitSpec`). Every field may be left out (or `null`): the
+ * scheme's default applies, and `defaultSpec(scheme, method)` lists them. Unknown names are
+ * rejected. Tolerances are % of the bounding-box diagonal; the README's options table says
+ * which scheme and method each option applies to.
+ */
+export interface FitSpec {
+  scheme?: Scheme | 'bspline';
+  method?: Method | null;
+  tolAvg?: number | null;
+  tolMax?: number | null;
+  tolRms?: number | null;
+  initial?: number | null;
+  grid?: [number, number] | null;
+  maxIter?: number | null;
+  refine?: boolean;
+  maxControl?: number | null;
+  weights?: 'basis' | 'patent';
+  acceleration?: 'none' | 'relax' | 'anderson' | 'cg' | null;
+  tangentWeight?: number | null;
+  refineGrowth?: number | null;
+  remesh?: boolean;
+  cloud?: 'auto' | 'open' | 'closed';
+  outliers?: number | null;
+  useGrid?: boolean;
+  closed?: boolean | null;
+  degree?: number | null;
+  tolMode?: 'exact' | 'noisy';
+  beta2?: number | null;
+  beta3?: number | null;
+  solves?: number | null;
+  view?: [number, number, number] | null;
+  folded?: 'fail' | 'exclude' | 'keep';
+  cornerAngle?: number | null;
+  curvatureJump?: number | null;
+}
+
+/** A `FitSpec` with every field written out, as `defaultSpec` gives it (`null`: the data decides). */
+export type ResolvedFitSpec = { [K in keyof FitSpec]-?: Exclude<FitSpec[K], undefined> } & {
+  scheme: Scheme;
+};
+
+/** `Fitter.stats()`: the current errors (in % of the diagonal and in model units), the last iteration's time and flags, the tolerances in force. */
+export interface FitStats {
+  /** Iterations run. */
+  iter: number;
+  controlPoints: number;
+  eAvgPct: number;
+  eMaxPct: number;
+  eRmsPct: number;
+  eAvg: number;
+  eMax: number;
+  eRms: number;
+  /** Bounding-box diagonal of the data, model units. */
+  diagonal: number;
+  /** Wall time of the last iteration. */
+  ms: number;
+  /** Wall time of all iterations. */
+  totalMs: number;
+  status: FitStatus;
+  /** Whether the last iteration refined the control net. */
+  refined: boolean;
+  scheme: Scheme;
+  method: Method;
+  tolAvgPct: number | null;
+  tolMaxPct: number | null;
+  tolRmsPct: number | null;
+  /** Surface → data: largest and 99th-percentile distance, % (`null` where not measured). */
+  eBackMaxPct: number | null;
+  eBackP99Pct: number | null;
+}
+
+/** One entry of `Fitter.history()`. */
+export interface HistoryEntry {
+  iter: number;
+  controlPoints: number;
+  eAvgPct: number;
+  eMaxPct: number;
+  eRmsPct: number;
+  ms: number;
+  refined: boolean;
+}
+
+/** One entry of `FitReport.history` (snake_case, as the CLI's `--json` writes it). */
+export interface IterationRecord {
+  iter: number;
+  control_points: number;
+  e_avg_pct: number;
+  e_max_pct: number;
+  e_rms_pct: number;
+  ms: number;
+  refined: boolean;
+  e_back_max_pct?: number;
+  e_back_p99_pct?: number;
+}
+
+/** How many, and the first few of them. */
+export interface Found<T> {
+  count: number;
+  first: T[];
+}
+
+/** What repairing the data mesh changed (`FitReport.simplification.repair`). */
+export interface RepairReport {
+  summary: string;
+  non_manifold_vertices: Found<number>;
+  vertices_added: number;
+  non_manifold_edges: Found<[number, number]>;
+  detached_faces: Found<number>;
+  dropped_faces: Found<number>;
+  degenerate_faces: Found<number>;
+  zero_area_faces: Found<number>;
+  duplicate_faces: Found<number>;
+  flipped_faces: Found<number>;
+  non_orientable_components: number;
+  cut_edges: Found<[number, number]>;
+  unreferenced_vertices: Found<number>;
+  polygons: number;
+  components: {
+    count: number;
+    largest_faces: number[];
+    data_only: Found<number>;
+    data_only_faces: number;
+  };
+}
+
+/** How the initial control mesh was made by QEM simplification. */
+export interface SimplifyReport {
+  target: number;
+  vertices: number;
+  triangles: number;
+  passes: number;
+  relaxations: { at_vertices: number; max_normal_change_deg: number; min_triangle_quality: number }[];
+  floor_note: string | null;
+  max_valence: number;
+  repair: RepairReport;
+}
+
+/** What was reconstructed from bare points. */
+export interface ReconstructionReport {
+  kind: string;
+  method: string;
+  outliers: number;
+  vertices: number;
+  triangles: number;
+  seconds: number;
+}
+
+/** The fields only a B-spline surface fit reports. */
+export interface SurfaceDetails {
+  control_points_u: number;
+  control_points_v: number;
+  folded_points: number;
+}
+
+/** The fields only a curve fit reports (`features`, `corners`, `std_pct` for the knots method). */
+export interface CurveDetails {
+  degree: number;
+  closed: boolean;
+  domain: [number, number];
+  /** 101 samples `[u, x, y, z]`. */
+  samples: [number, number, number, number][];
+  clamped?: { degree: number; knots: number[]; control_points: [number, number, number][] };
+  features?: number;
+  corners?: number;
+  std_pct?: number;
+}
+
+/** The fields every fit report has. */
+export interface FitReportCommon {
+  scheme: Scheme;
+  method: Method;
+  points: number;
+  initial_control_points: number;
+  final_control_points: number;
+  iterations: number;
+  e_avg_pct: number;
+  e_max_pct: number;
+  e_rms_pct: number;
+  e_back_max_pct?: number;
+  e_back_p99_pct?: number;
+  converged: boolean;
+  status: FitStatus;
+  within_tolerance_pct: number | null;
+  reconstruction?: ReconstructionReport;
+  simplification?: SimplifyReport;
+  strays?: { indices: number[] };
+  intake: string[];
+  precompute_s: number;
+  fit_s: number;
+  total_s: number;
+  history: IterationRecord[];
+}
+
+/** `JSON.parse(fitter.reportJson())`: set-up, final errors, times and history of a fit. */
+export type FitReport = FitReportCommon & (SurfaceDetails | CurveDetails | {});
