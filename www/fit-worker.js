@@ -95,6 +95,7 @@ const EXPORTS = {
   glb: (f) => f.exportGlb(),
   iges: (f) => f.exportIges(),
   step: (f) => f.exportStep(),
+  msh: (f) => f.exportFem({ format: 'msh' }),
   json: (f) => new TextEncoder().encode(f.reportJson()),
 };
 
@@ -135,8 +136,10 @@ const handlers = {
     if (!fitter) throw new Error('nothing is fitted yet');
     const make = EXPORTS[what];
     if (!make) throw new Error(`unknown export '${what}'`);
-    const bytes = make(fitter);
-    post({ type: MSG.exported, what, bytes }, [bytes.buffer]);
+    const made = make(fitter);
+    // The FEM export also reports its element quality.
+    const { bytes, quality } = made instanceof Uint8Array ? { bytes: made, quality: undefined } : made;
+    post({ type: MSG.exported, what, bytes, quality }, [bytes.buffer]);
   },
 };
 

@@ -28,13 +28,19 @@ pub fn mesh_bspline(
     let (nodes, normals) = eval_grid(surface, &us, &vs);
     let nv = vs.len();
     let id = |i: usize, j: usize| (i * nv + j) as u32;
-    let keep: Option<Vec<bool>> =
-        inside.map(|f| us.iter().flat_map(|&u| vs.iter().map(move |&v| f(u, v))).collect());
+    let keep: Option<Vec<bool>> = inside.map(|f| {
+        us.iter()
+            .flat_map(|&u| vs.iter().map(move |&v| f(u, v)))
+            .collect()
+    });
     let mut quads = Vec::with_capacity((us.len() - 1) * (nv - 1));
     for i in 0..us.len() - 1 {
         for j in 0..nv - 1 {
             let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
-            if keep.as_ref().is_none_or(|k| q.iter().any(|&c| k[c as usize])) {
+            if keep
+                .as_ref()
+                .is_none_or(|k| q.iter().any(|&c| k[c as usize]))
+            {
                 quads.push(q);
             }
         }

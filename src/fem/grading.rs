@@ -1,26 +1,22 @@
 //! Element size from curvature, and the parameter lines that equidistribute it.
 //!
-//! The local element size is h = L / (1 + g κ L): the target size L where the surface is flat,
-//! about 1 / (g κ) — g elements per radian of turning — where the radius of curvature is much
-//! smaller than L. A mesh line is then placed every unit of ∫ ds / h along the surface.
+//! The local element size is h = max(L / (1 + g κ L), L / [`MAX_REFINEMENT`]): the target size
+//! L where the surface is flat, about 1 / (g κ) — g elements per radian of turning — where the
+//! radius of curvature is much smaller than L, but never below L / 8, so curvature spikes (a
+//! noisy fit's wrinkles, a fold) cannot blow up the count. A mesh line is then placed every unit
+//! of ∫ ds / h along the surface.
 
 use super::{FemError, FemSize, MAX_ELEMENTS};
 use crate::geom::Vec3;
 
 /// The largest principal curvature |κ| from the first and second derivatives; 0 where the
 /// tangents are degenerate (no tangent plane, no curvature to grade by).
-pub(super) fn max_curvature(
-    du: Vec3,
-    dv: Vec3,
-    duu: Vec3,
-    duv: Vec3,
-    dvv: Vec3,
-) -> f64 {
+pub(super) fn max_curvature(du: Vec3, dv: Vec3, duu: Vec3, duv: Vec3, dvv: Vec3) -> f64 {
     let n = du.cross(dv);
     let area = n.length();
     let (e, f, g) = (du.dot(du), du.dot(dv), dv.dot(dv));
     let det = e * g - f * f;
-    if !(area > 0.0) || !(det > 1e-12 * e * g) {
+    if area.is_nan() || area <= 0.0 || det.is_nan() || det <= 1e-12 * e * g {
         return 0.0;
     }
     let n = n / area;
@@ -35,9 +31,12 @@ pub(super) fn max_curvature(
     }
 }
 
+/// How much smaller than L curvature may make an element.
+pub const MAX_REFINEMENT: f64 = 8.0;
+
 /// Elements per unit length at curvature `kappa`: 1 / h.
 pub(super) fn density(size: f64, kappa: f64, grading: f64) -> f64 {
-    1.0 / size + grading * kappa
+    (1.0 / size + grading * kappa).min(MAX_REFINEMENT / size)
 }
 
 /// A polyline's sampled length and curvature: `(segment length, curvature at its middle)`.
@@ -84,9 +83,13 @@ pub(super) fn resolve_size(
         FemSize::Count(n) => size_for_count(n, scale, &count),
     };
     let estimated = count(l);
-    if !(estimated <= MAX_ELEMENTS as f64) {
+    if estimated.is_nan() || estimated > MAX_ELEMENTS as f64 {
         return Err(FemError::TooMany {
-            estimated: if estimated.is_finite() { estimated } else { f64::MAX },
+            estimated: if estimated.is_finite() {
+                estimated
+            } else {
+                f64::MAX
+            },
             max: MAX_ELEMENTS,
         });
     }
@@ -114,7 +117,11 @@ pub(super) fn equidistribute(t: &[f64], weight: &[f64], intervals: usize) -> Vec
             seg += 1;
         }
         let (c0, c1) = (cum[seg - 1], cum[seg]);
-        let s = if c1 > c0 { ((goal - c0) / (c1 - c0)).clamp(0.0, 1.0) } else { 0.0 };
+        let s = if c1 > c0 {
+            ((goal - c0) / (c1 - c0)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         out.push(t[seg - 1] + s * (t[seg] - t[seg - 1]));
     }
     out[0] = t[0];
@@ -142,8 +149,8 @@ mod tests {
         let dv = (s(u, v + h) - s(u, v - h)) / (2.0 * h);
         let duu = (s(u + h, v) - 2.0 * s(u, v) + s(u - h, v)) / (h * h);
         let dvv = (s(u, v + h) - 2.0 * s(u, v) + s(u, v - h)) / (h * h);
-        let duv = (s(u + h, v + h) - s(u + h, v - h) - s(u - h, v + h) + s(u - h, v - h))
-            / (4.0 * h * h);
+        let duv =
+            (s(u + h, v + h) - s(u + h, v - h) - s(u - h, v + h) + s(u - h, v - h)) / (4.0 * h * h);
         let k = max_curvature(du, dv, duu, duv, dvv);
         assert!((k - 1.0 / r).abs() < 1e-4, "{k}");
         assert_eq!(max_curvature(du, du, duu, duv, dvv), 0.0);

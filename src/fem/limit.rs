@@ -34,7 +34,7 @@ pub fn mesh_limit(surface: &SubdivSurface, options: &FemOptions) -> Result<FemMe
     let counts = |l: f64| strips.counts(&samples, l, g);
     let l = resolve_size(options.size, scale, |l| strips.total(&counts(l)) as f64)?;
     let counts = counts(l);
-    Ok(Nodes::build(surface, &strips, &counts)?)
+    Nodes::build(surface, &strips, &counts)
 }
 
 /// The control quads' corners and the strip (class of edges linked through opposite sides of
@@ -92,7 +92,10 @@ impl Strips {
             }
             class[e] = class[r];
         }
-        let strip = pairs.iter().map(|[u, v]| [class[u.0], class[v.0]]).collect();
+        let strip = pairs
+            .iter()
+            .map(|[u, v]| [class[u.0], class[v.0]])
+            .collect();
         Ok(Strips {
             corners,
             strip,

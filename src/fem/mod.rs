@@ -40,6 +40,7 @@ mod limit;
 mod quality;
 
 pub use bspline::mesh_bspline;
+pub use grading::MAX_REFINEMENT;
 pub use limit::mesh_limit;
 pub use quality::FemQuality;
 
@@ -67,7 +68,8 @@ pub enum FemSize {
 pub struct FemOptions {
     /// Element size; default 10,000 elements.
     pub size: FemSize,
-    /// Curvature grading g ≥ 0: the local element size is h = L / (1 + g κ L) with κ the
+    /// Curvature grading g ≥ 0: the local element size is h = L / (1 + g κ L) (at least
+    /// L / [`MAX_REFINEMENT`]) with κ the
     /// largest principal curvature, so where the radius of curvature is far below L there are
     /// about g elements per radian of turning. 0 gives uniform elements; default 4.
     pub grading: f64,
@@ -104,7 +106,7 @@ impl FemOptions {
     /// Checks the size, count and grading.
     pub fn validate(&self) -> Result<(), FemError> {
         match self.size {
-            FemSize::Edge(l) if !(l.is_finite() && l > 0.0) => {
+            FemSize::Edge(l) if !l.is_finite() || l <= 0.0 => {
                 return Err(FemError::Invalid {
                     what: "element size",
                     expected: "a positive finite length",
@@ -120,7 +122,7 @@ impl FemOptions {
             }
             _ => {}
         }
-        if !(self.grading.is_finite() && self.grading >= 0.0) {
+        if !self.grading.is_finite() || self.grading < 0.0 {
             return Err(FemError::Invalid {
                 what: "grading",
                 expected: "a finite number ≥ 0",

@@ -9,8 +9,8 @@ use serde::Serialize;
 /// Per element: the **aspect ratio** is its longest edge over its shortest (1 for a square);
 /// the **skew angle** the largest deviation of a corner angle from 90°; the **scaled Jacobian**
 /// the smallest over the four corners of (a × b) · n / (|a| |b|), with a and b the corner's two
-/// edges in counter-clockwise order and n the surface normal at the corner (1 for a rectangle,
-/// ≤ 0 for an inverted or degenerate element).
+/// edges in counter-clockwise order and n the element's normal, negated when it points against
+/// the surface normal (1 for a rectangle, ≤ 0 for an inverted, bow-tie or degenerate element).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 #[serde(rename_all = "camelCase")]
 pub struct FemQuality {
@@ -32,11 +32,27 @@ pub struct FemQuality {
     pub jacobian_min: f64,
     /// Elements whose scaled Jacobian is ≤ 0 (inverted or degenerate).
     pub inverted: usize,
+    /// Elements across a fold of the surface itself: the surface normals at two of their
+    /// corners point against each other. A mesh that follows the surface inverts there
+    /// whatever its lines; the fit, not the mesher, is at fault.
+    pub on_folds: usize,
+    /// Inverted elements not across a fold of the surface: the mesher's own failures.
+    pub inverted_off_folds: usize,
 }
 
-/// The figures of one element: (aspect ratio, skew degrees, scaled Jacobian).
+/// Whether the surface normals at an element's corners point against each other.
+fn across_fold(n: &[Vec3; 4]) -> bool {
+    (0..4).any(|a| (a + 1..4).any(|b| n[a].dot(n[b]) < 0.0))
+}
+
+/// The figures of one element: (aspect ratio, skew degrees, scaled Jacobian). The corner
+/// Jacobians are taken about the element's own normal (its diagonals' cross product, as
+/// Verdict does for quads in 3D), signed by whether that normal agrees with the surface
+/// normals `n` at the corners, so an element turned against the surface counts as inverted.
 fn element(p: [Point3; 4], n: [Vec3; 4]) -> (f64, f64, f64) {
     let own = (p[2] - p[0]).cross(p[3] - p[1]).normalize_or_zero();
+    let side = own.dot(n.iter().copied().sum::<Vec3>());
+    let sign = if side < 0.0 { -1.0 } else { 1.0 };
     let (mut lo, mut hi) = (f64::INFINITY, 0.0_f64);
     let (mut skew, mut jac) = (0.0_f64, f64::INFINITY);
     for k in 0..4 {
@@ -45,16 +61,19 @@ fn element(p: [Point3; 4], n: [Vec3; 4]) -> (f64, f64, f64) {
         let (la, lb) = (a.length(), b.length());
         lo = lo.min(la);
         hi = hi.max(la);
-        let normal = if n[k] == Vec3::ZERO { own } else { n[k] };
         let c = a.cross(b);
         let sj = if la > 0.0 && lb > 0.0 {
-            c.dot(normal) / (la * lb)
+            sign * c.dot(own) / (la * lb)
         } else {
             0.0
         };
         jac = jac.min(if sj.is_finite() { sj } else { 0.0 });
         let angle = c.length().atan2(a.dot(b)).to_degrees();
-        skew = skew.max(if angle.is_finite() { (90.0 - angle).abs() } else { 90.0 });
+        skew = skew.max(if angle.is_finite() {
+            (90.0 - angle).abs()
+        } else {
+            90.0
+        });
     }
     let aspect = if lo > 0.0 && hi.is_finite() {
         hi / lo
@@ -65,7 +84,7 @@ fn element(p: [Point3; 4], n: [Vec3; 4]) -> (f64, f64, f64) {
 }
 
 /// The quality of `quads` over `nodes`, with `normals` the unit surface normal at every node
-/// (zero where the surface has none: the element's own normal stands in).
+/// (zero where the surface has none).
 pub(super) fn measure(nodes: &[Point3], normals: &[Vec3], quads: &[[u32; 4]]) -> FemQuality {
     let mut q = FemQuality {
         elements: quads.len(),
@@ -84,7 +103,10 @@ pub(super) fn measure(nodes: &[Point3], normals: &[Vec3], quads: &[[u32; 4]]) ->
         q.aspect_max = q.aspect_max.max(aspect);
         q.skew_max_deg = q.skew_max_deg.max(skew);
         q.jacobian_min = q.jacobian_min.min(jac);
+        let fold = across_fold(&n);
         q.inverted += usize::from(jac <= 0.0);
+        q.on_folds += usize::from(fold);
+        q.inverted_off_folds += usize::from(jac <= 0.0 && !fold);
         aspect_sum += aspect.min(1e300);
         skew_sum += skew;
     }
@@ -105,7 +127,8 @@ mod tests {
 
     #[test]
     fn a_rectangle_is_perfect_but_long() {
-        let p = [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)].map(|(x, y)| Point3::new(x, y, 0.0));
+        let p =
+            [(0.0, 0.0), (2.0, 0.0), (2.0, 1.0), (0.0, 1.0)].map(|(x, y)| Point3::new(x, y, 0.0));
         let (aspect, skew, jac) = element(p, UP);
         assert_eq!(aspect, 2.0);
         assert!(skew.abs() < 1e-12 && (jac - 1.0).abs() < 1e-12);
@@ -117,7 +140,8 @@ mod tests {
         let p = [(0.0, 0.0), (1.0, 0.0), (1.0 + s, s), (s, s)].map(|(x, y)| Point3::new(x, y, 0.0));
         let (_, skew, jac) = element(p, UP);
         assert!((skew - 45.0).abs() < 1e-9 && (jac - s).abs() < 1e-12);
-        let q = [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)].map(|(x, y)| Point3::new(x, y, 0.0));
+        let q =
+            [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0), (1.0, 0.0)].map(|(x, y)| Point3::new(x, y, 0.0));
         let m = measure(&q, &UP, &[[0, 1, 2, 3]]);
         assert_eq!(m.inverted, 1);
         assert!((m.jacobian_min + 1.0).abs() < 1e-12);

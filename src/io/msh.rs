@@ -71,7 +71,9 @@ pub fn write_msh(mesh: &PolyMesh, out: &mut impl Write) -> Result<(), WriteError
 /// The one surface entity, bounded by the mesh's box.
 fn write_entities(mesh: &PolyMesh, w: &mut impl Write) -> Result<(), WriteError> {
     let b = Aabb::from_points(mesh.positions());
-    let (lo, hi) = b.map_or(([0.0; 3], [0.0; 3]), |b| (b.min.to_array(), b.max.to_array()));
+    let (lo, hi) = b.map_or(([0.0; 3], [0.0; 3]), |b| {
+        (b.min.to_array(), b.max.to_array())
+    });
     w.write_all(b"$Entities\n0 0 1 0\n1")?;
     for x in lo.iter().chain(&hi) {
         write!(w, " {}", Decimal(*x))?;
