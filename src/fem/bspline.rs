@@ -88,17 +88,24 @@ impl SizeField {
     }
 
     /// The elements per unit parameter along u at each u sample and along v at each v sample,
-    /// for size `l` and grading `g`: the largest over the other direction's samples.
+    /// for size `l` and grading `g`: the size part |S_u| / L the largest over the other
+    /// direction's samples (no element longer than L), the curvature part |S_u| (1 / h − 1 / L)
+    /// their mean, so curvature that runs along a line refines it and a lone spike (a noisy
+    /// fit's wrinkle) does not refine the whole line.
     fn weights(&self, l: f64, g: f64) -> (Vec<f64>, Vec<f64>) {
-        let nv = self.v.len();
-        let (mut wu, mut wv) = (vec![0.0_f64; self.u.len()], vec![0.0_f64; nv]);
+        let (nu, nv) = (self.u.len(), self.v.len());
+        let (mut size_u, mut size_v) = (vec![0.0_f64; nu], vec![0.0_f64; nv]);
+        let (mut curv_u, mut curv_v) = (vec![0.0_f64; nu], vec![0.0_f64; nv]);
         for (idx, &(su, sv, k)) in self.at.iter().enumerate() {
-            let d = super::grading::density(l, k, g);
+            let extra = super::grading::density(l, k, g) - 1.0 / l;
             let (i, j) = (idx / nv, idx % nv);
-            wu[i] = wu[i].max(su * d);
-            wv[j] = wv[j].max(sv * d);
+            size_u[i] = size_u[i].max(su / l);
+            size_v[j] = size_v[j].max(sv / l);
+            curv_u[i] += su * extra / nv as f64;
+            curv_v[j] += sv * extra / nu as f64;
         }
-        (wu, wv)
+        let add = |a: Vec<f64>, b: Vec<f64>| a.iter().zip(&b).map(|(x, y)| x + y).collect();
+        (add(size_u, curv_u), add(size_v, curv_v))
     }
 }
 

@@ -137,13 +137,12 @@ pub(super) fn intervals(elements: f64) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use Vec3;
 
     #[test]
     fn curvature_of_a_sphere_is_one_over_its_radius() {
         // S(u, v) = r (cos u cos v, sin u cos v, sin v) at u = 0.3, v = 0.2.
         let (r, u, v) = (2.5_f64, 0.3_f64, 0.2_f64);
-        let s = |u: f64, v: f64| DVec3::new(u.cos() * v.cos(), u.sin() * v.cos(), v.sin()) * r;
+        let s = |u: f64, v: f64| Vec3::new(u.cos() * v.cos(), u.sin() * v.cos(), v.sin()) * r;
         let h = 1e-4;
         let du = (s(u + h, v) - s(u - h, v)) / (2.0 * h);
         let dv = (s(u, v + h) - s(u, v - h)) / (2.0 * h);

@@ -3,8 +3,8 @@
 //!
 //! - **B-spline surface** ([`mesh_bspline`]): a structured mesh of u and v parameter lines. The
 //!   lines are placed by equidistributing ∫ ds / h along each direction, h the local element
-//!   size (see [`FemOptions::grading`]), taking the largest over the other direction so no
-//!   element is longer than h; elements follow the parameter lines, and since the lines
+//!   size (see [`FemOptions::grading`]): the flat-size part the largest over the other
+//!   direction so no element is longer than L, the curvature part its mean; elements follow the parameter lines, and since the lines
 //!   increase strictly no element inverts in the parameter plane. An optional inside test on
 //!   (u, v) trims the mesh to the data: an element is kept when at least one of its corners is
 //!   inside, dropped when all four are outside.
