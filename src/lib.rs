@@ -36,6 +36,7 @@
 //! | [`io`] | readers and writers for point and mesh files |
 //! | [`cloud`] | bare point clouds to meshes (range grid, Delaunay, implicit surface) |
 //! | [`export`] | IGES and STEP export of B-spline / NURBS curves and surfaces; what any fit exports |
+//! | [`fem`] | quadrilateral FEM meshes of fitted B-spline and Catmull–Clark surfaces, graded by curvature, with element quality |
 //! | [`render`] | the wgpu viewer (GPU part on `wasm32` only) and its f32 draw buffers |
 //! | `wasm` | JavaScript bindings (`wasm32` only) |
 //!
@@ -47,6 +48,7 @@ mod macros;
 
 pub mod cloud;
 pub mod export;
+pub mod fem;
 pub mod fit;
 pub mod geom;
 pub mod io;

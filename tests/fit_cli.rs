@@ -146,3 +146,83 @@ fn the_page_sample_converges_both_ways_with_the_defaults() {
     }
     std::fs::remove_file(&json).ok();
 }
+
+/// `--fem` writes the FEM quad mesh (MSH, or OBJ quads for `.obj`) and prints its quality; the
+/// FEM flags are refused where they do not apply (issue 18).
+#[test]
+fn fem_flags_write_the_quad_mesh_or_fail_with_a_message() {
+    let dir = std::env::temp_dir().join(format!("geofit-fem-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let spot = data_file("spot.obj");
+    let spot = spot.to_str().expect("utf-8");
+    let (msh, obj) = (dir.join("spot.msh"), dir.join("spot.obj"));
+    for (out, size) in [
+        (&msh, ["--fem-count", "3000"]),
+        (&obj, ["--fem-size", "0.05"]),
+    ] {
+        let out_s = out.to_str().expect("utf-8");
+        let stdout = geofit_ok(&[
+            "fit",
+            spot,
+            "--scheme",
+            "catmull-clark",
+            "-q",
+            "--fem",
+            out_s,
+            size[0],
+            size[1],
+        ]);
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with("FEM mesh: "))
+            .expect("quality line");
+        let quads: usize = line["FEM mesh: ".len()..]
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(line.contains(" 0 inverted"), "{line}");
+        let text = std::fs::read_to_string(out).expect("written");
+        if out == &msh {
+            assert!(text.starts_with("$MeshFormat\n4.1 0 8\n"));
+            assert!(text.contains(&format!("\n2 1 3 {quads}\n")), "{line}");
+            assert!((quads as f64 / 3000.0 - 1.0).abs() < 0.25, "{line}");
+        } else {
+            assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), quads);
+            assert!(text
+                .lines()
+                .filter(|l| l.starts_with("f "))
+                .all(|l| l.split(' ').count() == 5));
+        }
+    }
+    let msh_s = msh.to_str().expect("utf-8");
+    for (args, message) in [
+        (
+            vec!["fit", spot, "--scheme", "loop", "--fem", msh_s],
+            "--fem does not apply to --scheme loop",
+        ),
+        (vec!["fit", spot, "--fem-size", "1"], "need --fem FILE"),
+        (
+            vec![
+                "fit",
+                spot,
+                "--scheme",
+                "catmull-clark",
+                "--max-iter",
+                "1",
+                "--fem",
+                msh_s,
+                "--fem-size",
+                "0",
+            ],
+            "FEM element size must be a positive finite length, got 0",
+        ),
+    ] {
+        let out = geofit(&args);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(message), "{args:?}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -27,8 +27,15 @@ const DOWNLOADS = {
   ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
   glb: ['geofit-surface.glb', 'model/gltf-binary'],
   iges: ['geofit.igs', 'model/iges'], step: ['geofit.stp', 'model/step'],
-  json: ['geofit-report.json', 'application/json'],
+  msh: ['geofit-fem.msh', 'text/plain'], json: ['geofit-report.json', 'application/json'],
 };
+
+/** The FEM export's quality line. @param {import('../pkg/geofit.js').FemQuality} q */
+function femText(q) {
+  return `FEM mesh: ${q.elements} quads, ${q.nodes} nodes; aspect ratio ${q.aspectMean.toFixed(2)} mean, `
+    + `${q.aspectMax.toFixed(1)} max; skew max ${q.skewMaxDeg.toFixed(1)}°; scaled Jacobian min `
+    + `${q.jacobianMin.toFixed(3)}; ${q.inverted} inverted (${q.inverted - q.invertedOffFolds} on folds of the surface)`;
+}
 
 const STATUS_TEXT = {
   building: 'building the control net…', paused: 'paused', running: 'fitting…',
@@ -311,6 +318,7 @@ class FitPanel {
       }
     } else if (m.type === MSG.exported) {
       download(m.bytes, ...DOWNLOADS[m.what]);
+      if (m.quality) el('fit-fem-quality').textContent = femText(m.quality);
     } else if (m.type === MSG.error) {
       if (m.generation !== this.generation) return;
       this.host.showError(`Fit (${m.during}): ${m.message}`);

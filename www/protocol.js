@@ -31,7 +31,8 @@
  * }} FrameMessage
  *   The state of the fit after a slice; `once` (data points, initial control net and what was
  *   done to the data on intake) only on the first frame of a fit.
- * @typedef {{ type: 'exported', what: string, bytes: Uint8Array }} ExportedMessage
+ * @typedef {{ type: 'exported', what: string, bytes: Uint8Array, quality?: import('../pkg/geofit.js').FemQuality }} ExportedMessage
+ *   An export's bytes; `quality` for the FEM mesh (`msh`).
  * @typedef {{ type: 'error', during: string, generation: number, message: string }} ErrorMessage
  * @typedef {FrameMessage | ExportedMessage | ErrorMessage} FromWorker
  */

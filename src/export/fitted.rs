@@ -12,13 +12,15 @@ use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 
 /// The exports a fit of `scheme` offers: `cage` and `json` always, `obj`/`ply`/`stl`/`glb` for
-/// surfaces, `iges`/`step` for B-splines.
+/// surfaces, `iges`/`step` for B-splines, `msh` (the FEM quad mesh, [`crate::fem`]) for
+/// B-spline and Catmull–Clark surfaces.
 pub fn exports_for(scheme: Scheme) -> &'static [&'static str] {
     match scheme {
-        Scheme::Loop | Scheme::CatmullClark | Scheme::DooSabin => {
-            &["cage", "obj", "ply", "stl", "glb", "json"]
-        }
-        Scheme::BsplineSurface => &["cage", "obj", "ply", "stl", "glb", "iges", "step", "json"],
+        Scheme::Loop | Scheme::DooSabin => &["cage", "obj", "ply", "stl", "glb", "json"],
+        Scheme::CatmullClark => &["cage", "obj", "ply", "stl", "glb", "msh", "json"],
+        Scheme::BsplineSurface => &[
+            "cage", "obj", "ply", "stl", "glb", "iges", "step", "msh", "json",
+        ],
         Scheme::BsplineCurve | Scheme::ChaikinCurve => &["cage", "iges", "step", "json"],
     }
 }

@@ -216,6 +216,11 @@ pub trait Fitter {
         None
     }
 
+    /// The fitted subdivision limit surface, for the FEM mesh; other fits have none.
+    fn subdiv_surface(&self) -> Option<&crate::subdiv::SubdivSurface> {
+        None
+    }
+
     /// What only this engine reports (control grid, fold-overs, features, curve samples), as
     /// JSON fields that [`FitReport`] writes beside the common ones.
     fn details(&self) -> serde_json::Map<String, serde_json::Value> {

@@ -49,6 +49,7 @@ mod glb;
 mod gltf;
 mod grid;
 mod las;
+mod msh;
 mod obj;
 mod pcd;
 mod ply;
@@ -64,6 +65,7 @@ pub use glb::{
     DIVERGING_POSITIVE, DIVERGING_ZERO,
 };
 pub use grid::RangeGrid;
+pub use msh::{to_msh_bytes, write_msh};
 pub use write::{
     to_obj_bytes, to_ply_bytes, to_stl_bytes, write_obj, write_ply, write_stl, WriteError,
 };

@@ -132,8 +132,8 @@ pub fn write_stl(mesh: &PolyMesh, out: &mut impl Write) -> Result<(), WriteError
 
 /// The shortest decimal that reads back as the same f64: plain for moderate magnitudes,
 /// scientific (`1e300`, `2.5e-7`) otherwise, where plain notation would run to hundreds of
-/// digits.
-struct Decimal(f64);
+/// digits. Shared by the text writers (OBJ, Gmsh).
+pub(super) struct Decimal(pub(super) f64);
 
 impl std::fmt::Display for Decimal {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

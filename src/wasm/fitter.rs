@@ -5,6 +5,7 @@
 
 use super::scan::LoadedScan;
 use crate::export;
+use crate::fem;
 use crate::fit::{
     FitReport, FitSpec, FitStatus, Fitter as CoreFitter, IterationRecord, Method, Scheme, Shape,
 };
@@ -424,7 +425,7 @@ impl Fitter {
     }
 
     /// The export named `what` (one of `exportsFor(scheme)`: `cage`, `obj`, `ply`, `stl`, `glb`,
-    /// `iges`, `step`, `json`) as bytes, as the `export*` method of that name gives it; the
+    /// `iges`, `step`, `json`, `msh`: the FEM quad mesh with the default options) as bytes, as the `export*` method of that name gives it; the
     /// workers export by name through this one table. Throws on another name, or when the
     /// scheme has no such export.
     #[wasm_bindgen(js_name = exportAs)]
@@ -441,10 +442,39 @@ impl Fitter {
             "iges" => self.export_iges(),
             "step" => self.export_step(),
             "json" => Ok(self.report_json()?.into_bytes()),
+            "msh" => Ok(self.fem_export(&FemJsOptions::default())?.0),
             _ => Err(JsError::new(&format!(
-                "unknown export '{what}': one of cage, obj, ply, stl, glb, iges, step, json"
+                "unknown export '{what}': one of cage, obj, ply, stl, glb, iges, step, json, msh"
             ))),
         }
+    }
+
+    /// The FEM quad mesh of the fitted B-spline or Catmull–Clark surface ([`crate::fem`]):
+    /// `options` is `{size?, count?, grading?, format?}` (`size` the target edge length in model
+    /// units or `count` the number of elements, default 10,000; `grading` default 4; `format`
+    /// `"msh"` (Gmsh 4.1 ASCII, default) or `"obj"`). Returns `{bytes, quality}`, `quality`
+    /// holding `elements`, `nodes`, `aspectMin/Mean/Max`, `skewMaxDeg`, `skewMeanDeg`,
+    /// `jacobianMin`, `inverted`, `onFolds`, `invertedOffFolds`. Throws on bad options and for
+    /// other schemes.
+    #[wasm_bindgen(js_name = exportFem, unchecked_return_type = "FemExport")]
+    pub fn export_fem(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "FemExportOptions | null | undefined")] options: JsValue,
+    ) -> Result<JsValue, JsError> {
+        let o: FemJsOptions = if options.is_undefined() || options.is_null() {
+            FemJsOptions::default()
+        } else {
+            let value: serde_json::Value = serde_wasm_bindgen::from_value(options)?;
+            serde_json::from_value(value).map_err(|e| JsError::new(&format!("FEM options: {e}")))?
+        };
+        let (bytes, mesh) = self.fem_export(&o)?;
+        let out = js_sys::Object::new();
+        let bytes = js_sys::Uint8Array::from(bytes.as_slice());
+        js_sys::Reflect::set(&out, &"bytes".into(), &bytes)
+            .map_err(|_| JsError::new("exportFem"))?;
+        js_sys::Reflect::set(&out, &"quality".into(), &to_js(mesh.quality())?)
+            .map_err(|_| JsError::new("exportFem"))?;
+        Ok(out.into())
     }
 
     /// What happened to the data before the first iteration, one line each ("repaired: 3
@@ -463,8 +493,44 @@ impl Fitter {
     }
 }
 
+/// The options object of [`Fitter::export_fem`]; unknown names are errors.
+#[derive(Default, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FemJsOptions {
+    size: Option<f64>,
+    count: Option<usize>,
+    grading: Option<f64>,
+    format: Option<String>,
+}
+
 impl Fitter {
     fn export_mesh(&self) -> Result<PolyMesh, JsError> {
         Ok(export::surface_mesh(self.fit.as_ref())?)
+    }
+}
+
+impl Fitter {
+    /// The FEM quad mesh `o` asks for, and its file (Gmsh `.msh` or OBJ quads).
+    fn fem_export(&self, o: &FemJsOptions) -> Result<(Vec<u8>, fem::FemMesh), JsError> {
+        if o.size.is_some() && o.count.is_some() {
+            return Err(JsError::new("FEM options: give size or count, not both"));
+        }
+        let mut fem_options = fem::FemOptions::default();
+        if let Some(l) = o.size {
+            fem_options = fem_options.with_edge(l);
+        }
+        if let Some(n) = o.count {
+            fem_options = fem_options.with_count(n);
+        }
+        if let Some(g) = o.grading {
+            fem_options = fem_options.with_grading(g);
+        }
+        let mesh = fem::mesh_fit(self.fit.as_ref(), &fem_options)?;
+        let bytes = match o.format.as_deref() {
+            None | Some("msh") => io::to_msh_bytes(mesh.mesh())?,
+            Some("obj") => io::to_obj_bytes(mesh.mesh())?,
+            Some(f) => return Err(JsError::new(&format!("FEM format '{f}': use msh or obj"))),
+        };
+        Ok((bytes, mesh))
     }
 }

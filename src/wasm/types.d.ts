@@ -12,7 +12,7 @@ export type Method = 'geometric' | 'least-squares' | 'knots';
 /** How a fit stands: still iterating, or why it stopped. */
 export type FitStatus = 'running' | 'converged' | 'max_iterations' | 'stalled';
 /** The exports of a fit; `exportsFor(scheme)` says which a scheme offers. */
-export type ExportName = 'cage' | 'json' | 'obj' | 'ply' | 'stl' | 'glb' | 'iges' | 'step';
+export type ExportName = 'cage' | 'json' | 'obj' | 'ply' | 'stl' | 'glb' | 'iges' | 'step' | 'msh';
 /** The file formats `loadFile` reads. */
 export type FileFormat =
   | 'ply' | 'obj' | 'stl' | 'xyz' | 'e57' | 'las' | 'laz' | 'pcd' | 'ptx' | 'gltf' | 'glb';
@@ -20,7 +20,7 @@ export type FileFormat =
 /**
  * The options of a fit (the core's `FitSpec`). Every field may be left out (or `null`): the
  * scheme's default applies, and `defaultSpec(scheme, method)` lists them. Unknown names are
- * rejected. Tolerances are % of the bounding-box diagonal; the README's options table says
+ * rejected. Tolerances are % of the bounding-box diagonal; docs/options.md says
  * which scheme and method each option applies to.
  */
 export interface FitSpec {
@@ -213,3 +213,36 @@ export interface FitReportCommon {
 
 /** `JSON.parse(fitter.reportJson())`: set-up, final errors, times and history of a fit. */
 export type FitReport = FitReportCommon & (SurfaceDetails | CurveDetails | {});
+
+/** The options of `Fitter.exportFem`: element size (`size`, model units) or count, not both. */
+export interface FemExportOptions {
+  /** Target edge length in flat parts, model units. */
+  size?: number | null;
+  /** Number of elements (default 10,000 when no size is given). */
+  count?: number | null;
+  /** How much curvature shrinks the elements (default 4). */
+  grading?: number | null;
+  /** `'msh'` (Gmsh 4.1 ASCII, default) or `'obj'` (OBJ quads). */
+  format?: 'msh' | 'obj' | null;
+}
+
+/** Element quality of a FEM quad mesh (`FemQuality` in the core). */
+export interface FemQuality {
+  elements: number;
+  nodes: number;
+  aspectMin: number;
+  aspectMean: number;
+  aspectMax: number;
+  skewMaxDeg: number;
+  skewMeanDeg: number;
+  jacobianMin: number;
+  inverted: number;
+  onFolds: number;
+  invertedOffFolds: number;
+}
+
+/** What `Fitter.exportFem` returns: the file and the mesh's quality. */
+export interface FemExport {
+  bytes: Uint8Array;
+  quality: FemQuality;
+}

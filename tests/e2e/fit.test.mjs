@@ -96,6 +96,24 @@ function checkCad(iges, step, entity, controlPoints) {
 }
 
 /** Picks a bundled sample and waits until it is shown and its fit is idle. */
+/** Clicks the FEM MSH export and checks the file's counted blocks against the page's quality line. */
+async function checkFem(page, tag) {
+  const { bytes } = await exportBytes(page, 'msh', tag);
+  const lines = bytes.toString('latin1').split('\n');
+  assert.deepEqual(lines.slice(0, 3), ['$MeshFormat', '4.1 0 8', '$EndMeshFormat']);
+  const nodes = Number(lines[lines.indexOf('$Nodes') + 1].split(' ')[1]);
+  const at = lines.indexOf('$Elements');
+  const quads = Number(lines[at + 1].split(' ')[1]);
+  assert.equal(lines[at + 2], `2 1 3 ${quads}`, 'one block of 4-node quads');
+  assert.equal(lines[at + 3].split(' ').length, 5);
+  await page.waitForFunction(() => document.getElementById('fit-fem-quality').textContent !== '');
+  const text = await page.textContent('#fit-fem-quality');
+  assert.match(text, new RegExp(`^FEM mesh: ${quads} quads, ${nodes} nodes`), text);
+  assert.ok(quads > 5_000 && quads < 15_000, `about 10,000 elements: ${quads}`);
+  await page.evaluate(() => { document.getElementById('fit-fem-quality').textContent = ''; });
+  return text;
+}
+
 async function pickSample(page, file, count) {
   await page.selectOption('#sample', file);
   await page.waitForFunction((n) => document.getElementById('num-points').textContent === n, count, { timeout: TIMEOUT_MS });
@@ -258,6 +276,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     }
     assert.ok(await page.isDisabled('[data-export="iges"]'), 'no IGES for a subdivision surface');
     assert.ok(await page.isDisabled('[data-export="step"]'), 'no STEP for a subdivision surface');
+    assert.ok(await page.isDisabled('[data-export="msh"]'), 'no FEM mesh for a Loop surface');
     const { bytes: json } = await exportBytes(page, 'json', tag);
     const report = JSON.parse(json.toString('utf8'));
     assert.equal(report.converged, true);
@@ -285,6 +304,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     assert.equal(stats.scheme, 'catmull-clark');
     assert.ok(stats.iter >= 1 && stats.iter <= 4, `iterations: ${stats.iter}`);
     assert.equal(await page.evaluate(() => window.geofitFit.history.length), stats.iter);
+    console.log(`[e2e] ${backend.name} catmull-clark ${await checkFem(page, `${backend.name}-cc`)}`);
     await page.fill('#fit-max-iter', '200');
   });
 
@@ -336,6 +356,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     const iges = (await exportBytes(page, 'iges', tag)).bytes;
     const step = (await exportBytes(page, 'step', tag)).bytes;
     checkCad(iges, step, 'surface', stats.controlPoints);
+    console.log(`[e2e] ${backend.name} bspline-surface ${await checkFem(page, tag)}`);
   });
 
   test('B-spline and Chaikin curves fit the section; the curve and IGES/STEP export', async () => {
@@ -420,6 +441,9 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
           }
         })(),
         caught(() => new m.Fitter(mesh, { initial: 0 })),
+        caught(() => curve.exportFem()),
+        caught(() => loop.exportFem()),
+        caught(() => loop.exportFem({ cells: 4 })),
       ];
       // Bare points are meshed first (here by Delaunay, an open scan), then fitted like a mesh.
       const cloudFitter = new m.Fitter(cloud, { scheme: 'loop', maxIter: 2 });
@@ -449,6 +473,9 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     const started = Number(/^started with (\d+)$/.exec(messages[8])?.[1]);
     assert.ok(started >= 100 && started <= 400, messages[8]);
     assert.match(messages[9], /initial/);
+    assert.match(messages[10], /FEM quad mesh needs a surface/);
+    assert.match(messages[11], /FEM quad mesh of a Loop surface is not made/);
+    assert.match(messages[12], /FEM options: unknown field `cells`/);
   });
 
   test('user files from the corpus fit with no setting touched; repairs are listed', async () => {

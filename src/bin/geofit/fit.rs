@@ -5,6 +5,7 @@
 
 use crate::output::read_input;
 use geofit::export::{self, EXPORT_RESOLUTION};
+use geofit::fem::{self, FemOptions};
 use geofit::fit::{Acceleration, FoldPolicy, TolMode};
 use geofit::fit::{
     Cloud, FitData, FitError, FitReport, FitSpec, FitStatus, Fitter, Method, Scheme, Shape, Spline,
@@ -152,6 +153,20 @@ pub struct Args {
     /// B-spline surface or curve: export as STEP AP214.
     #[arg(long)]
     step: Option<PathBuf>,
+    /// B-spline or Catmull–Clark surface: write a quad mesh for finite-element analysis, as Gmsh
+    /// MSH 4.1 ASCII, or as OBJ quads when the name ends in `.obj`; prints its element quality.
+    #[arg(long)]
+    fem: Option<PathBuf>,
+    /// --fem: target element edge length (model units) where the surface is flat.
+    #[arg(long, conflicts_with = "fem_count")]
+    fem_size: Option<f64>,
+    /// --fem: about this many elements instead of --fem-size (default 10000).
+    #[arg(long)]
+    fem_count: Option<usize>,
+    /// --fem: curvature grading g, about g elements per radian where the surface is curved
+    /// (0: uniform; default 4).
+    #[arg(long)]
+    fem_grading: Option<f64>,
     /// Print only the summary, not one line per iteration.
     #[arg(long, short)]
     quiet: bool,
@@ -266,6 +281,11 @@ impl Args {
             ("--limit", self.limit.is_some(), !s.is_curve()),
             ("--glb", self.glb.is_some(), !s.is_curve()),
             (
+                "--fem",
+                self.fem.is_some(),
+                matches!(s, Scheme::BsplineSurface | Scheme::CatmullClark),
+            ),
+            (
                 "--surface-json",
                 self.surface_json.is_some(),
                 s == Scheme::BsplineSurface,
@@ -284,6 +304,14 @@ impl Args {
             if given && !ok {
                 return Err(format!("{flag} does not apply to --scheme {s}"));
             }
+        }
+        let fem_flags = [
+            self.fem_size.is_some(),
+            self.fem_count.is_some(),
+            self.fem_grading.is_some(),
+        ];
+        if self.fem.is_none() && fem_flags.contains(&true) {
+            return Err("--fem-size, --fem-count and --fem-grading need --fem FILE".into());
         }
         Ok(())
     }
@@ -452,6 +480,54 @@ fn write_outputs(
             std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
         }
     }
+    if let Some(path) = &args.fem {
+        write_fem(fitter, args, path)?;
+    }
+    Ok(())
+}
+
+/// The FEM quad mesh of the fitted surface, written as MSH (OBJ for a `.obj` name), and its
+/// quality printed.
+fn write_fem(fitter: &dyn Fitter, args: &Args, path: &std::path::Path) -> Result<(), String> {
+    let mut options = FemOptions::default();
+    if let Some(l) = args.fem_size {
+        options = options.with_edge(l);
+    }
+    if let Some(n) = args.fem_count {
+        options = options.with_count(n);
+    }
+    if let Some(g) = args.fem_grading {
+        options = options.with_grading(g);
+    }
+    let start = Instant::now();
+    let fem = fem::mesh_fit(fitter, &options).map_err(|e| format!("--fem: {e}"))?;
+    let mesh_s = start.elapsed().as_secs_f64();
+    let obj = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("obj"));
+    let bytes = if obj {
+        geofit::io::to_obj_bytes(fem.mesh())
+    } else {
+        geofit::io::to_msh_bytes(fem.mesh())
+    };
+    let bytes = bytes.map_err(|e| format!("--fem: {e}"))?;
+    std::fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+    let q = fem.quality();
+    outln!(
+        "FEM mesh: {} quads, {} nodes in {:.3} s; aspect ratio {:.2} / {:.2} / {:.2} (min / mean / max), skew max {:.1}°, scaled Jacobian min {:.3}, {} inverted ({} across {} elements on folds of the surface) -> {}",
+        q.elements,
+        q.nodes,
+        mesh_s,
+        q.aspect_min,
+        q.aspect_mean,
+        q.aspect_max,
+        q.skew_max_deg,
+        q.jacobian_min,
+        q.inverted,
+        q.inverted - q.inverted_off_folds,
+        q.on_folds,
+        path.display()
+    );
     Ok(())
 }
 

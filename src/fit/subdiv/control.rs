@@ -38,6 +38,10 @@ impl ControlSurface for SubdivSurface {
         self.control_mesh().to_poly_mesh().unwrap_or_default()
     }
 
+    fn as_subdiv(&self) -> Option<&SubdivSurface> {
+        Some(self)
+    }
+
     fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError> {
         Ok(self.with_mesh(control_mesh_of(SubdivSurface::scheme(self), control)?)?)
     }

@@ -77,6 +77,12 @@ pub trait ControlSurface: LimitSurface + ClosestPoint<Param = SurfaceParam> + Si
         None
     }
 
+    /// The surface as a [`SubdivSurface`](crate::subdiv::SubdivSurface), when it is one (for
+    /// the FEM mesh); the default is none.
+    fn as_subdiv(&self) -> Option<&crate::subdiv::SubdivSurface> {
+        None
+    }
+
     /// Local remeshing after a refinement (edge flips for triangle schemes) of `control`, the
     /// result of [`ControlSurface::refine_control`] on this surface's mesh (its vertices past
     /// this surface's control points are the new ones). Returns the number of changes; the
@@ -728,5 +734,9 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
 
     fn limit_shape(&self, resolution: usize) -> Shape {
         Shape::Mesh(self.limit_mesh(resolution))
+    }
+
+    fn subdiv_surface(&self) -> Option<&crate::subdiv::SubdivSurface> {
+        self.surface.as_subdiv()
     }
 }

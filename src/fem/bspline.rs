@@ -1,0 +1,169 @@
+//! The FEM mesh of a B-spline surface: a structured grid of u and v parameter lines, graded by
+//! curvature, optionally trimmed by an inside test.
+
+use super::grading::{equidistribute, intervals, max_curvature, resolve_size};
+use super::{FemError, FemMesh, FemOptions};
+use crate::geom::{Aabb, Point3, Vec3};
+use crate::spline::{BSplineSurface, KnotVector, MAX_DEGREE};
+
+/// The FEM quad mesh of `surface` (see the [module](super) docs). `inside(u, v)`, when given,
+/// trims it: elements whose four corners are all outside are dropped.
+pub fn mesh_bspline(
+    surface: &BSplineSurface,
+    options: &FemOptions,
+    inside: Option<&dyn Fn(f64, f64) -> bool>,
+) -> Result<FemMesh, FemError> {
+    options.validate()?;
+    let field = SizeField::sample(surface);
+    let g = options.grading;
+    let scale = Aabb::from_points(surface.control_points()).map_or(1.0, |b| b.diagonal());
+    let scale = if scale > 0.0 { scale } else { 1.0 };
+    let l = resolve_size(options.size, scale, |l| {
+        let (wu, wv) = field.weights(l, g);
+        intervals(integral(&field.u, &wu)) as f64 * intervals(integral(&field.v, &wv)) as f64
+    })?;
+    let (wu, wv) = field.weights(l, g);
+    let us = equidistribute(&field.u, &wu, intervals(integral(&field.u, &wu)));
+    let vs = equidistribute(&field.v, &wv, intervals(integral(&field.v, &wv)));
+    let (nodes, normals) = eval_grid(surface, &us, &vs);
+    let nv = vs.len();
+    let id = |i: usize, j: usize| (i * nv + j) as u32;
+    let keep: Option<Vec<bool>> = inside.map(|f| {
+        us.iter()
+            .flat_map(|&u| vs.iter().map(move |&v| f(u, v)))
+            .collect()
+    });
+    let mut quads = Vec::with_capacity((us.len() - 1) * (nv - 1));
+    for i in 0..us.len() - 1 {
+        for j in 0..nv - 1 {
+            let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+            if keep
+                .as_ref()
+                .is_none_or(|k| q.iter().any(|&c| k[c as usize]))
+            {
+                quads.push(q);
+            }
+        }
+    }
+    FemMesh::assemble(nodes, normals, quads)
+}
+
+/// ∫ w dt over the samples (trapezoid rule).
+fn integral(t: &[f64], w: &[f64]) -> f64 {
+    t.windows(2)
+        .zip(w.windows(2))
+        .map(|(t, w)| 0.5 * (w[0] + w[1]) * (t[1] - t[0]))
+        .sum()
+}
+
+/// Speeds |S_u|, |S_v| and curvature on a sample grid of the domain.
+struct SizeField {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    /// Per sample (i along u, j along v, at `i * v.len() + j`): (|S_u|, |S_v|, κ).
+    at: Vec<(f64, f64, f64)>,
+}
+
+impl SizeField {
+    /// Samples 8 per knot span in each direction (33 to 257 samples).
+    fn sample(s: &BSplineSurface) -> SizeField {
+        let ((u0, u1), (v0, v1)) = s.domain();
+        let samples = |k: &KnotVector, a: f64, b: f64| {
+            let spans = k.num_basis() - k.degree();
+            let n = (8 * spans + 1).clamp(33, 257);
+            (0..n)
+                .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+                .collect::<Vec<f64>>()
+        };
+        let (u, v) = (samples(s.knots_u(), u0, u1), samples(s.knots_v(), v0, v1));
+        let mut at = Vec::with_capacity(u.len() * v.len());
+        for &a in &u {
+            for &b in &v {
+                let d = s.derivs(a, b, 2).skl;
+                let k = max_curvature(d[1][0], d[0][1], d[2][0], d[1][1], d[0][2]);
+                at.push((d[1][0].length(), d[0][1].length(), k));
+            }
+        }
+        SizeField { u, v, at }
+    }
+
+    /// The elements per unit parameter along u at each u sample and along v at each v sample,
+    /// for size `l` and grading `g`: the size part |S_u| / L the largest over the other
+    /// direction's samples (no element longer than L), the curvature part |S_u| (1 / h − 1 / L)
+    /// their mean, so curvature that runs along a line refines it and a lone spike (a noisy
+    /// fit's wrinkle) does not refine the whole line.
+    fn weights(&self, l: f64, g: f64) -> (Vec<f64>, Vec<f64>) {
+        let (nu, nv) = (self.u.len(), self.v.len());
+        let (mut size_u, mut size_v) = (vec![0.0_f64; nu], vec![0.0_f64; nv]);
+        let (mut curv_u, mut curv_v) = (vec![0.0_f64; nu], vec![0.0_f64; nv]);
+        for (idx, &(su, sv, k)) in self.at.iter().enumerate() {
+            let extra = super::grading::density(l, k, g) - 1.0 / l;
+            let (i, j) = (idx / nv, idx % nv);
+            size_u[i] = size_u[i].max(su / l);
+            size_v[j] = size_v[j].max(sv / l);
+            curv_u[i] += su * extra / nv as f64;
+            curv_v[j] += sv * extra / nu as f64;
+        }
+        let add = |a: Vec<f64>, b: Vec<f64>| a.iter().zip(&b).map(|(x, y)| x + y).collect();
+        (add(size_u, curv_u), add(size_v, curv_v))
+    }
+}
+
+/// The non-zero basis values and first derivatives at one parameter.
+struct Basis {
+    first: usize,
+    ders: [[f64; MAX_DEGREE + 1]; 2],
+}
+
+fn basis(k: &KnotVector, t: f64) -> Basis {
+    let span = k.find_span(t);
+    let mut ders = [[0.0; MAX_DEGREE + 1]; 2];
+    k.basis_ders(span, t, 1, &mut ders);
+    Basis {
+        first: span - k.degree(),
+        ders,
+    }
+}
+
+/// Positions and unit normals at every (us[i], vs[j]), at `i * vs.len() + j`. The basis of each
+/// line is computed once, so a node costs one (p + 1)(q + 1) sum.
+fn eval_grid(s: &BSplineSurface, us: &[f64], vs: &[f64]) -> (Vec<Point3>, Vec<Vec3>) {
+    let bu: Vec<Basis> = us.iter().map(|&u| basis(s.knots_u(), u)).collect();
+    let bv: Vec<Basis> = vs.iter().map(|&v| basis(s.knots_v(), v)).collect();
+    let (p, q) = (s.knots_u().degree(), s.knots_v().degree());
+    let nv = s.num_control().1;
+    let (ctrl, weights) = (s.control_points(), s.weights());
+    let mut nodes = Vec::with_capacity(us.len() * vs.len());
+    let mut normals = Vec::with_capacity(us.len() * vs.len());
+    for a in &bu {
+        for b in &bv {
+            // Homogeneous sums (w = 1 without weights): value, ∂u and ∂v of Σ w P and of Σ w.
+            let (mut s0, mut su, mut sv) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+            let (mut w0, mut wu, mut wv) = (0.0, 0.0, 0.0);
+            for r in 0..=p {
+                let row = (a.first + r) * nv + b.first;
+                let (mut c0, mut cv, mut cw0, mut cwv) = (Vec3::ZERO, Vec3::ZERO, 0.0, 0.0);
+                for t in 0..=q {
+                    let w = weights.map_or(1.0, |w| w[row + t]);
+                    let wp = ctrl[row + t] * w;
+                    c0 += b.ders[0][t] * wp;
+                    cv += b.ders[1][t] * wp;
+                    cw0 += b.ders[0][t] * w;
+                    cwv += b.ders[1][t] * w;
+                }
+                let (n0, n1) = (a.ders[0][r], a.ders[1][r]);
+                s0 += n0 * c0;
+                su += n1 * c0;
+                sv += n0 * cv;
+                w0 += n0 * cw0;
+                wu += n1 * cw0;
+                wv += n0 * cwv;
+            }
+            let point = s0 / w0;
+            let (du, dv) = ((su - wu * point) / w0, (sv - wv * point) / w0);
+            nodes.push(point);
+            normals.push(du.cross(dv).normalize_or_zero());
+        }
+    }
+    (nodes, normals)
+}
