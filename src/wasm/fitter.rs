@@ -459,7 +459,8 @@ impl Fitter {
     #[wasm_bindgen(js_name = exportFem, unchecked_return_type = "FemExport")]
     pub fn export_fem(
         &self,
-        #[wasm_bindgen(unchecked_param_type = "FemExportOptions | null | undefined")] options: JsValue,
+        #[wasm_bindgen(unchecked_param_type = "FemExportOptions | null | undefined")]
+        options: JsValue,
     ) -> Result<JsValue, JsError> {
         let o: FemJsOptions = if options.is_undefined() || options.is_null() {
             FemJsOptions::default()
