@@ -23,8 +23,16 @@
  * Worker → page.
  * @typedef {{ positions: Float32Array, normals: Float32Array, indices: Uint32Array, edges: Uint32Array }} Shape
  * @typedef {{
+ *   points: number, mean: number, sigma: number, p50: number, p90: number, p95: number, p99: number,
+ *   max: number, tolerance: number | null, withinTolerancePct: number | null,
+ *   halfWidth: number, counts: number[], below: number, above: number,
+ * }} Deviation
+ *   `Fitter.deviations(bins)`: the signed errors' figures (model units; percentiles of |d|) and
+ *   their histogram over -halfWidth..halfWidth (the end bins hold the points beyond).
+ * @typedef {{
  *   type: 'frame', kind: 'start' | 'play' | 'pause' | 'step', generation: number, playing: boolean,
  *   stats: Object<string, any>, history: Object<string, any>[], errors: Float32Array,
+ *   deviation: Deviation,
  *   limit: Shape, control: { positions: Float32Array, edges: Uint32Array },
  *   vectors: Float32Array, iso: Float32Array,
  *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array }, notes: string[] },
