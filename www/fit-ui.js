@@ -116,7 +116,7 @@ class FitPanel {
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
     // deviation: the latest frame's distribution of the errors (protocol.js `Deviation`).
-    this.figures = { lastStats: null, history: [], deviation: null, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
+    this.figures = { lastStats: null, history: [], deviation: null, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
     this.tolUnits = [
       linkTolerance(this.ui.tolAvg, this.ui.tolAvgUnits, () => this.diagonal(), () => this.form.edited.add('tolAvg')),
       linkTolerance(this.ui.tolMax, this.ui.tolMaxUnits, () => this.diagonal(), () => this.form.edited.add('tolMax')),
@@ -323,8 +323,12 @@ class FitPanel {
       this.figures.frames += 1;
       this.showStats(m.stats);
       this.figures.deviation = m.deviation;
+      const t0 = performance.now();
       this.showDeviation(m.deviation);
+      const t1 = performance.now();
       drawChart(this.ui.chart, m.history, this.chartTolerances(m.stats));
+      this.figures.deviationMs = Math.max(this.figures.deviationMs, t1 - t0);
+      this.figures.chartMs = Math.max(this.figures.chartMs, performance.now() - t1);
     } else if (k === 1) {
       if (viewer) this.drawPoints(viewer);
     } else if (k === 2) {

@@ -89,6 +89,11 @@ for (const backend of BACKENDS) describe(`deviation views and page links, ${back
         for (const e of list.getEntries()) window.longTasks.push(e.duration);
       }).observe({ type: 'longtask', buffered: true });
     });
+    await page.route('**/samples/broken.ply', (route) => route.fulfill({
+      status: 200,
+      contentType: 'application/octet-stream',
+      body: 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n2 x\n',
+    }));
     await open('');
   });
 
@@ -98,10 +103,15 @@ for (const backend of BACKENDS) describe(`deviation views and page links, ${back
   });
 
   test('histogram, statistics, CSV and picking agree on the fitted bunny', async () => {
+    await page.evaluate(() => { window.longTasks = []; });
     await page.click('#fit-play');
     await page.waitForSelector('body[data-fit="converged"]', { timeout: TIMEOUT_MS });
     await page.waitForTimeout(300);
     const longTasks = await page.evaluate(() => window.longTasks);
+    const f = await page.evaluate(() => window.geofitFit);
+    console.log(`${backend.name}: ${f.frames} frames; longest stages of showing one (figures, points, surface, lines): ` +
+      `${f.stageMs.map((ms) => Math.round(ms)).join(', ')} ms; of the figures, deviation views ${f.deviationMs.toFixed(1)} ms, ` +
+      `convergence chart ${f.chartMs.toFixed(1)} ms; long tasks ${JSON.stringify(longTasks)}`);
     const dev = await page.evaluate(() => window.geofitFit.deviation);
     const stats = await page.evaluate(() => window.geofitFit.lastStats);
     // The histogram: every point in one bin, symmetric range covering the band.
@@ -172,7 +182,8 @@ for (const backend of BACKENDS) describe(`deviation views and page links, ${back
 
   for (const [label, query, message] of [
     ['a cross-origin src is refused', '?src=http://example.invalid/bunny.obj', /own site .* not of http:\/\/example\.invalid/],
-    ['a bad file via src', '?src=/tests/data/truncated.stl', /truncated\.stl/],
+    // Served by the test (page.route below): a PLY whose vertex line is cut short.
+    ['a bad file via src', '?src=samples/broken.ply', /Could not load broken\.ply: /],
     ['an unknown parameter', '?src=samples/bunny.obj&tolerance=1', /unknown page parameter 'tolerance'/],
     ['a parameter that is not a number', '?src=samples/bunny.obj&tolMax=abc', /tolMax=abc: not a number/],
     ['a scheme that does not exist', '?src=samples/bunny.obj&scheme=nurbs', /scheme=nurbs: not one of/],
