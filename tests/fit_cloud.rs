@@ -91,7 +91,10 @@ fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
     assert_eq!(d.points, points.len());
     let e_max = stats.e_max_pct / 100.0 * fitter.diagonal();
     assert!((d.max - e_max).abs() <= 1e-9 * e_max, "{d:?} vs {stats:?}");
-    assert!(d.p50 <= d.p90 && d.p90 <= d.p95 && d.p95 <= d.p99 && d.p99 <= d.max, "{d:?}");
+    assert!(
+        d.p50 <= d.p90 && d.p90 <= d.p95 && d.p95 <= d.p99 && d.p99 <= d.max,
+        "{d:?}"
+    );
     assert!(d.tolerance.is_some_and(|t| d.max <= t), "{d:?}");
 }
 

@@ -121,7 +121,7 @@ impl OrbitCamera {
         let mut best: Option<(usize, f32)> = None;
         for (i, p) in xyz.chunks_exact(3).enumerate() {
             let clip = m * Vec3::from_slice(p).extend(1.0);
-            if !(clip.w > 0.0) {
+            if clip.w.is_nan() || clip.w <= 0.0 {
                 continue;
             }
             let ndc = clip.truncate() / clip.w;
