@@ -85,6 +85,17 @@ fn closed_cloud_with_duplicates_is_reconstructed_and_fitted() {
     );
     let report = FitReport::of(fitter.as_ref());
     assert_eq!(report.within_tolerance_pct, Some(100.0));
+    // The deviation figures: of every point, the largest |d| is E_max, within the tolerance.
+    let d = report.deviation;
+    assert_eq!(d.within_tolerance_pct, report.within_tolerance_pct);
+    assert_eq!(d.points, points.len());
+    let e_max = stats.e_max_pct / 100.0 * fitter.diagonal();
+    assert!((d.max - e_max).abs() <= 1e-9 * e_max, "{d:?} vs {stats:?}");
+    assert!(
+        d.p50 <= d.p90 && d.p90 <= d.p95 && d.p95 <= d.p99 && d.p99 <= d.max,
+        "{d:?}"
+    );
+    assert!(d.tolerance.is_some_and(|t| d.max <= t), "{d:?}");
 }
 
 #[test]

@@ -15,8 +15,8 @@
 import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
 import {
-  CAGE_COLOR, CHART_CONTEXT, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, drawChart, edgeSegments,
-  errorColors, fmtPct, fmtUnits, lineSet,
+  CAGE_COLOR, CHART_CONTEXT, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
+  drawHistogram, edgeSegments, errorColors, fmtPct, fmtUnits, lineSet,
 } from './fit-view.js';
 
 export { drawChart, errorColors } from './fit-view.js';
@@ -29,6 +29,8 @@ const DOWNLOADS = {
   iges: ['geofit.igs', 'model/iges'], step: ['geofit.stp', 'model/step'],
   msh: ['geofit-fem.msh', 'text/plain'], json: ['geofit-report.json', 'application/json'],
 };
+// CSS pixels around a click within which a data point is picked.
+const PICK_RADIUS = 6;
 
 /** The FEM export's quality line. @param {import('../pkg/geofit.js').FemQuality} q */
 function femText(q) {
@@ -97,6 +99,10 @@ class FitPanel {
       eMax: el('fit-emax'), eRms: el('fit-erms'), eBack: el('fit-eback'), ms: el('fit-ms'), total: el('fit-total'),
       intake: el('fit-intake'),
       legendTol: el('legend-tol'), legendNeg: el('legend-neg'),
+      histogram: /** @type {HTMLCanvasElement} */ (el('dev-histogram')),
+      devMean: el('dev-mean'), devP50: el('dev-p50'), devP95: el('dev-p95'), devMax: el('dev-max'),
+      devWithin: el('dev-within'), devCsv: /** @type {HTMLButtonElement} */ (el('dev-csv')),
+      pickLabel: el('pick-label'),
     };
     this.form = new FitForm(this.ui.form);
     this.worker = new Worker(new URL('./fit-worker.js', import.meta.url), { type: 'module' });
@@ -116,7 +122,8 @@ class FitPanel {
     this.showing = false;
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
-    this.figures = { lastStats: null, history: [], frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
+    // deviation: the latest frame's distribution of the errors (protocol.js `Deviation`).
+    this.figures = { lastStats: null, history: [], deviation: null, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
     this.tolUnits = [
       linkTolerance(this.ui.tolAvg, this.ui.tolAvgUnits, () => this.diagonal(), () => this.form.edited.add('tolAvg')),
       linkTolerance(this.ui.tolMax, this.ui.tolMaxUnits, () => this.diagonal(), () => this.form.edited.add('tolMax')),
@@ -154,9 +161,15 @@ class FitPanel {
     this.generation += 1;
     Object.assign(this, { built: 0, playing: false, frame: null, pending: null, once: null });
     this.worker.postMessage({ type: MSG.clear, generation: this.generation });
-    Object.assign(this.figures, { lastStats: null, history: [] });
+    Object.assign(this.figures, { lastStats: null, history: [], deviation: null });
     const u = this.ui;
-    for (const dd of [u.iter, u.ctrl, u.eAvg, u.eMax, u.eRms, u.eBack, u.ms, u.total]) dd.textContent = '—';
+    for (const dd of [u.iter, u.ctrl, u.eAvg, u.eMax, u.eRms, u.eBack, u.ms, u.total, u.devMean, u.devP50, u.devP95, u.devMax, u.devWithin]) {
+      dd.textContent = '—';
+    }
+    u.devCsv.disabled = true;
+    u.pickLabel.hidden = true;
+    const h = /** @type {CanvasRenderingContext2D | null} */ (u.histogram.getContext('2d', CHART_CONTEXT));
+    h?.clearRect(0, 0, u.histogram.width, u.histogram.height);
     this.showIntake([]);
     delete document.body.dataset.fitIter;
     const g = /** @type {CanvasRenderingContext2D | null} */ (u.chart.getContext('2d', CHART_CONTEXT));
@@ -242,6 +255,52 @@ class FitPanel {
   }
 
   /**
+   * The deviation figures and histogram of a frame.
+   * @param {import('./protocol.js').Deviation} d
+   */
+  showDeviation(d) {
+    const u = this.ui;
+    const signed = (v) => `${v >= 0 ? '+' : '−'}${fmtUnits(Math.abs(v))}`;
+    u.devMean.textContent = `${signed(d.mean)} ± ${fmtUnits(d.sigma)}`;
+    u.devP50.textContent = `${fmtUnits(d.p50)} / ${fmtUnits(d.p90)}`;
+    u.devP95.textContent = `${fmtUnits(d.p95)} / ${fmtUnits(d.p99)}`;
+    u.devMax.textContent = fmtUnits(d.max);
+    u.devWithin.textContent = d.withinTolerancePct == null ? 'no E_max tolerance'
+      : `${d.withinTolerancePct.toFixed(2)} % (±${fmtUnits(d.tolerance ?? 0)})`;
+    u.devCsv.disabled = false;
+    drawHistogram(u.histogram, d);
+  }
+
+  /** Downloads the per-point deviations of the frame on screen as CSV. */
+  downloadCsv() {
+    if (!this.frame || !this.once) return;
+    const text = deviationCsv(this.once.data, this.frame.errors, this.frame.deviation);
+    download(new TextEncoder().encode(text), 'geofit-deviations.csv', 'text/csv');
+  }
+
+  /**
+   * Shows the index, position and deviation of the data point seen at CSS pixel `x`, `y` of
+   * the view (nothing there, or no fit yet: hides the label).
+   */
+  pick(x, y) {
+    const label = this.ui.pickLabel;
+    const viewer = this.host.viewer();
+    const i = viewer && this.frame && this.once ? viewer.pick(this.once.data, x, y, PICK_RADIUS) : undefined;
+    if (i === undefined) {
+      label.hidden = true;
+      return;
+    }
+    const p = this.once.data.subarray(3 * i, 3 * i + 3);
+    const d = this.frame.errors[i];
+    const pct = this.frame.stats.diagonal > 0 ? ` (${fmtPct((100 * d) / this.frame.stats.diagonal)})` : '';
+    label.textContent = `point ${i} (${[...p].map((v) => v.toPrecision(5)).join(', ')}): deviation ${d >= 0 ? '+' : ''}${fmtUnits(d)}${pct}`;
+    Object.assign(label.dataset, { index: String(i), deviation: String(d) });
+    label.style.left = `${x + 10}px`;
+    label.style.top = `${y + 10}px`;
+    label.hidden = false;
+  }
+
+  /**
    * Lists what the core did to the data before fitting (repair, reconstruction, a
    * simplification that stopped above its target); hidden when nothing was done.
    * @param {string[]} notes
@@ -270,7 +329,13 @@ class FitPanel {
       Object.assign(this.figures, { lastStats: m.stats, history: m.history });
       this.figures.frames += 1;
       this.showStats(m.stats);
+      this.figures.deviation = m.deviation;
+      const t0 = performance.now();
+      this.showDeviation(m.deviation);
+      const t1 = performance.now();
       drawChart(this.ui.chart, m.history, this.chartTolerances(m.stats));
+      this.figures.deviationMs = Math.max(this.figures.deviationMs, t1 - t0);
+      this.figures.chartMs = Math.max(this.figures.chartMs, performance.now() - t1);
     } else if (k === 1) {
       if (viewer) this.drawPoints(viewer);
     } else if (k === 2) {
@@ -336,6 +401,7 @@ class FitPanel {
       this.go('error');
     };
     u.play.addEventListener('click', () => this.play());
+    u.devCsv.addEventListener('click', () => this.downloadCsv());
     u.step.addEventListener('click', () => this.step());
     u.reset.addEventListener('click', () => this.restart());
     this.form.scheme.addEventListener('change', () => this.form.schemeChanged());
@@ -361,6 +427,9 @@ class FitPanel {
     new ResizeObserver(() => {
       if (this.figures.history.length) drawChart(u.chart, this.figures.history, this.chartTolerances(this.figures.lastStats));
     }).observe(u.chart);
+    new ResizeObserver(() => {
+      if (this.figures.deviation) drawHistogram(u.histogram, this.figures.deviation);
+    }).observe(u.histogram);
   }
 
   /** A new scan was loaded: `preset` holds the options that suit a bundled sample. */
@@ -374,12 +443,13 @@ class FitPanel {
 
 /**
  * Wires the fitting panel. `host` gives the viewer, a render request and the error line.
- * Returns `{ onScan(bytes, name, diagonal, preset), figures }`.
+ * Returns `{ onScan(bytes, name, diagonal, preset), pick(x, y), figures }`.
  */
 export function createFitUi(host) {
   const panel = new FitPanel(host);
   return {
     onScan: (bytes, name, diagonal, preset) => panel.onScan(bytes, name, diagonal, preset),
+    pick: (x, y) => panel.pick(x, y),
     figures: panel.figures,
   };
 }

@@ -135,3 +135,79 @@ export function drawChart(canvas, history, tolerances) {
     g.stroke();
   }
 }
+
+/**
+ * Draws the histogram of signed deviations `dev` (see protocol.js `Deviation`): one bar per
+ * bin in the point colour of its centre, the tolerance band ±`dev.tolerance` shaded, 0 and the
+ * range's ends labelled. 64 bars: cheap enough for every frame.
+ * @param {HTMLCanvasElement} canvas
+ * @param {import('./protocol.js').Deviation} dev
+ */
+export function drawHistogram(canvas, dev) {
+  const ratio = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * ratio));
+  const h = Math.max(1, Math.round(canvas.clientHeight * ratio));
+  if (canvas.width !== w || canvas.height !== h) {
+    canvas.width = w;
+    canvas.height = h;
+  }
+  const g = /** @type {CanvasRenderingContext2D} */ (canvas.getContext('2d', CHART_CONTEXT));
+  g.setTransform(ratio, 0, 0, ratio, 0, 0);
+  const cw = w / ratio;
+  const ch = h / ratio;
+  g.fillStyle = '#10141b';
+  g.fillRect(0, 0, cw, ch);
+  const pad = { l: 8, r: 8, t: 6, b: 16 };
+  const n = dev.counts.length;
+  const top = Math.max(1, ...dev.counts);
+  const x = (d) => pad.l + ((d + dev.halfWidth) / (2 * dev.halfWidth)) * (cw - pad.l - pad.r);
+  const tol = dev.tolerance ?? 0;
+  if (tol > 0) {
+    g.fillStyle = 'rgba(126, 224, 126, 0.18)';
+    const a = x(Math.max(-tol, -dev.halfWidth));
+    g.fillRect(a, pad.t, x(Math.min(tol, dev.halfWidth)) - a, ch - pad.t - pad.b);
+  }
+  const binWidth = (2 * dev.halfWidth) / n;
+  const centres = Float32Array.from(dev.counts, (_, k) => -dev.halfWidth + (k + 0.5) * binWidth);
+  const colors = errorColors(centres, tol);
+  const barW = (cw - pad.l - pad.r) / n;
+  dev.counts.forEach((count, k) => {
+    if (count === 0) return;
+    const [r, gg, b] = colors.subarray(k * 3, k * 3 + 3);
+    g.fillStyle = `rgb(${Math.round(r * 255)}, ${Math.round(gg * 255)}, ${Math.round(b * 255)})`;
+    const bh = Math.max(1, (count / top) * (ch - pad.t - pad.b));
+    g.fillRect(pad.l + k * barW, ch - pad.b - bh, Math.max(1, barW - 1), bh);
+  });
+  g.strokeStyle = '#9aa3ad';
+  g.beginPath();
+  g.moveTo(x(0), pad.t);
+  g.lineTo(x(0), ch - pad.b);
+  g.stroke();
+  g.font = '10px system-ui, sans-serif';
+  g.fillStyle = '#9aa3ad';
+  g.fillText(`−${fmtUnits(dev.halfWidth)}`, pad.l, ch - 4);
+  g.fillText('0', x(0) - 3, ch - 4);
+  const right = `+${fmtUnits(dev.halfWidth)}`;
+  g.fillText(right, cw - pad.r - g.measureText(right).width, ch - 4);
+}
+
+/**
+ * The per-point deviations as CSV text: `#` header lines with the figures of `dev`, then
+ * `index,x,y,z,deviation` per point (model units; the deviation signed, + above the surface).
+ * @param {Float32Array} positions  x, y, z per point
+ * @param {Float32Array} errors  signed deviation per point, in the order of `positions`
+ * @param {import('./protocol.js').Deviation} dev
+ */
+export function deviationCsv(positions, errors, dev) {
+  const figure = (v) => (v == null ? '' : String(v));
+  const lines = [
+    `# points,${dev.points}`,
+    ...['mean', 'sigma', 'p50', 'p90', 'p95', 'p99', 'max', 'tolerance', 'withinTolerancePct']
+      .map((k) => `# ${k},${figure(dev[k])}`),
+    'index,x,y,z,deviation',
+  ];
+  for (let i = 0; i < errors.length; i += 1) {
+    lines.push(`${i},${positions[3 * i]},${positions[3 * i + 1]},${positions[3 * i + 2]},${errors[i]}`);
+  }
+  return `${lines.join('\n')}\n`;
+}

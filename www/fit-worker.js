@@ -1,7 +1,8 @@
 // @ts-check
 // The fitting worker: owns a geofit `Fitter` and iterates it off the main thread. After every
 // `run(budget)` slice (at least one iteration, at most ~40 ms of work when iterations are fast) it
-// posts a frame (see protocol.js): statistics, history, signed point errors, the limit mesh (or
+// posts a frame (see protocol.js): statistics, history, signed point errors and their
+// distribution (figures and histogram), the limit mesh (or
 // curve), the control-net edges, the error vectors and iso-parameter lines, all as transferable
 // typed arrays.
 import init, { Fitter, loadFile } from '../pkg/geofit.js';
@@ -14,6 +15,8 @@ const SLICE_MS = 40;
 const LIMIT_RESOLUTION = 3;
 const RUNNING_RESOLUTION = 2;
 const MAX_TRIANGLES = 40_000;
+// Bins of the deviation histogram the page draws.
+const HISTOGRAM_BINS = 64;
 let resolution = LIMIT_RESOLUTION;
 
 /** @type {Fitter | null} */
@@ -52,6 +55,7 @@ function postFrame(f, kind) {
     stats: f.stats(),
     history: f.history(),
     errors: f.pointErrors(),
+    deviation: f.deviations(HISTOGRAM_BINS),
     limit: { positions: limit.positions, normals: limit.normals, indices: limit.indices, edges: limit.edges },
     control: { positions: control.positions, edges: control.edges },
     vectors: f.errorVectors(),

@@ -166,17 +166,28 @@ function resize() {
 function bindCamera() {
   const c = ui.canvas;
   let last = null;
+  // A press released within CLICK_SLOP CSS pixels of where it started is a click: it picks
+  // the data point there (fit-ui.js shows its deviation); a drag moves the camera.
+  const CLICK_SLOP = 3;
+  let down = null;
   c.addEventListener('contextmenu', (e) => e.preventDefault());
   c.addEventListener('pointerdown', (e) => {
     c.setPointerCapture(e.pointerId);
     c.focus();
     last = { x: e.clientX, y: e.clientY };
+    down = e.button === 0 ? last : null;
+  });
+  c.addEventListener('click', (e) => {
+    if (!down || Math.hypot(e.clientX - down.x, e.clientY - down.y) > CLICK_SLOP) return;
+    const r = c.getBoundingClientRect();
+    fitUi?.pick(e.clientX - r.left, e.clientY - r.top);
   });
   c.addEventListener('pointermove', (e) => {
     if (!last || !viewer) return;
     const dx = e.clientX - last.x;
     const dy = e.clientY - last.y;
     last = { x: e.clientX, y: e.clientY };
+    if (down && Math.hypot(e.clientX - down.x, e.clientY - down.y) > CLICK_SLOP) el('pick-label').hidden = true;
     const panning = e.shiftKey || (e.buttons & 2) !== 0 || (e.buttons & 4) !== 0;
     if (panning) viewer.pan(dx, dy);
     else viewer.orbit(dx, dy);
@@ -278,7 +289,70 @@ async function main() {
   updateLayers();
   await listSamples();
   ui.sample.addEventListener('change', () => openSample(ui.sample.value));
+  const params = new URLSearchParams(location.search);
+  if (params.has('src')) await openLink(params);
+  else await openSample(ui.sample.value);
+}
+
+/**
+ * The fit options of a page link: every parameter but `src` names a FitSpec field by its
+ * camelCase name (as the form does: `scheme`, `tolMax`, `refine`, ...) and is read as the
+ * form's control reads it. Throws naming a parameter the form has no field for or a value that
+ * is not of its kind; the core checks the values' ranges when it builds the fit.
+ * @param {URLSearchParams} params
+ */
+function linkPreset(params) {
+  const form = /** @type {HTMLFormElement} */ (el('fit-form'));
+  /** @type {Object<string, unknown>} */
+  const preset = {};
+  for (const [name, text] of params) {
+    if (name === 'src') continue;
+    const control = form.elements.namedItem(name);
+    if (!(control instanceof HTMLInputElement || control instanceof HTMLSelectElement)) {
+      throw new Error(`unknown page parameter '${name}' (the fit options are ${[...form.querySelectorAll('[name]')].map((c) => c.getAttribute('name')).join(', ')})`);
+    }
+    if (control instanceof HTMLSelectElement && name !== 'method' && ![...control.options].some((o) => o.value === text)) {
+      throw new Error(`page parameter ${name}=${text}: not one of ${[...control.options].map((o) => o.value).filter(Boolean).join(', ')}`);
+    }
+    if (control instanceof HTMLInputElement && control.type === 'checkbox') {
+      if (!['true', 'false', '1', '0'].includes(text)) throw new Error(`page parameter ${name}=${text}: not true or false`);
+      preset[name] = text === 'true' || text === '1';
+    } else if (control instanceof HTMLInputElement && control.type === 'number') {
+      const value = Number(text);
+      if (text.trim() === '' || !Number.isFinite(value)) throw new Error(`page parameter ${name}=${text}: not a number`);
+      preset[name] = value;
+    } else {
+      preset[name] = text;
+    }
+  }
+  return preset;
+}
+
+/**
+ * Opens the file of a page link `?src=URL&scheme=…&tolMax=…` (teaching links, embedding): a
+ * file of this site only, with the link's fit options. On a refused link or a bad file the
+ * page opens the first sample and shows why.
+ * @param {URLSearchParams} params
+ */
+async function openLink(params) {
+  const src = params.get('src') ?? '';
+  let problem;
+  try {
+    const url = new URL(src, location.href);
+    if (url.origin !== location.origin) {
+      throw new Error(`the page opens files of its own site only (${location.origin}), not of ${url.origin}`);
+    }
+    const preset = linkPreset(params);
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`HTTP ${response.status}`);
+    const name = decodeURIComponent(url.pathname.split('/').pop() || 'file');
+    if (show(new Uint8Array(await response.arrayBuffer()), name, preset)) return;
+    problem = ui.error.textContent;
+  } catch (e) {
+    problem = `Could not open ?src=${src}: ${e?.message ?? e}`;
+  }
   await openSample(ui.sample.value);
+  showError(problem);
 }
 
 /** Fills the sample list from the manifest; the first sample opens at start. */

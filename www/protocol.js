@@ -25,6 +25,7 @@
  * @typedef {{
  *   type: 'frame', kind: 'start' | 'play' | 'pause' | 'step', generation: number, playing: boolean,
  *   stats: import('../pkg/geofit.js').FitStats, history: import('../pkg/geofit.js').HistoryEntry[], errors: Float32Array,
+ *   deviation: import('../pkg/geofit.js').Deviation,
  *   limit: Shape, control: { positions: Float32Array, edges: Uint32Array },
  *   vectors: Float32Array, iso: Float32Array,
  *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array }, notes: string[] },

@@ -16,6 +16,7 @@
 
 mod accel;
 mod curve;
+mod deviation;
 mod error;
 mod log;
 mod parallel;
@@ -34,6 +35,7 @@ pub use curve::{
     least_squares_curve, CurveFitOptions, CurveFitter, KnotFeature, KnotPlacementFitter,
     KnotPlacementOptions,
 };
+pub use deviation::{DeviationHistogram, DeviationStats};
 pub use error::FitError;
 pub use log::FitLog;
 pub use reference::{BackStats, DataSurface};

@@ -1,7 +1,9 @@
 //! The machine-readable summary of a fit (`geofit fit --json`, `Fitter.reportJson()`): one
 //! builder, [`FitReport::of`], for every engine.
 
-use super::{FitStatus, Fitter, IterationRecord, ReconstructionReport, StrayPoints};
+use super::{
+    DeviationStats, FitStatus, Fitter, IterationRecord, ReconstructionReport, StrayPoints,
+};
 use crate::mesh::SimplifyReport;
 use serde::Serialize;
 
@@ -40,6 +42,9 @@ pub struct FitReport {
     /// Share of the data points within the E_max tolerance of the surface, % (`None` without
     /// an E_max tolerance): the figure that matters for noisy scans, whose E_max is noise.
     pub within_tolerance_pct: Option<f64>,
+    /// The distribution of the signed point deviations (model units): mean, σ, percentiles of
+    /// |d|, the share within the E_max tolerance (the same figure as `within_tolerance_pct`).
+    pub deviation: DeviationStats,
     /// What was reconstructed from bare points before simplification (absent for meshes).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reconstruction: Option<ReconstructionReport>,
@@ -74,6 +79,11 @@ impl FitReport {
         let stats = fitter.stats();
         let precompute_s = log.precompute_seconds();
         let fit_s = log.fit_seconds();
+        let deviation = DeviationStats::of(
+            fitter.point_errors(),
+            fitter.diagonal(),
+            fitter.tolerances().max_pct,
+        );
         FitReport {
             scheme: fitter.scheme().to_string(),
             method: fitter.method().to_string(),
@@ -88,10 +98,8 @@ impl FitReport {
             e_back_p99_pct: fitter.state().back().map(|b| b.p99_pct),
             converged: log.status() == FitStatus::Converged,
             status: log.status(),
-            within_tolerance_pct: fitter
-                .tolerances()
-                .max_pct
-                .map(|tol| within_tolerance_pct(fitter.point_errors(), fitter.diagonal(), tol)),
+            within_tolerance_pct: deviation.within_tolerance_pct,
+            deviation,
             reconstruction: log.reconstruction().cloned(),
             simplification: log.simplification().cloned(),
             strays: log.strays().cloned(),

@@ -92,9 +92,100 @@ impl OrbitCamera {
     }
 }
 
+/// Where to pick and how far around: a spot in CSS pixels of a view `width` × `height` CSS
+/// pixels, and the largest distance in CSS pixels a point may be from it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PickSpot {
+    /// CSS pixels from the left edge of the view.
+    pub x: f32,
+    /// CSS pixels from the top edge of the view.
+    pub y: f32,
+    /// View width, CSS pixels.
+    pub width: f32,
+    /// View height, CSS pixels.
+    pub height: f32,
+    /// Largest distance of a picked point from the spot, CSS pixels.
+    pub radius: f32,
+}
+
+impl OrbitCamera {
+    /// The index of the point of `xyz` (flat `x, y, z`) nearest the eye among those drawn
+    /// within `spot.radius` CSS pixels of the spot, or `None`. Points drawn as discs overlap
+    /// this way: the front one is the one seen.
+    pub fn pick(&self, xyz: &[f32], spot: PickSpot) -> Option<usize> {
+        if !(spot.width > 0.0 && spot.height > 0.0) {
+            return None;
+        }
+        let m = self.view_proj(spot.width / spot.height);
+        let r2 = spot.radius * spot.radius;
+        let mut best: Option<(usize, f32)> = None;
+        for (i, p) in xyz.chunks_exact(3).enumerate() {
+            let clip = m * Vec3::from_slice(p).extend(1.0);
+            if clip.w.is_nan() || clip.w <= 0.0 {
+                continue;
+            }
+            let ndc = clip.truncate() / clip.w;
+            if !(0.0..=1.0).contains(&ndc.z) {
+                continue;
+            }
+            let sx = (ndc.x + 1.0) * 0.5 * spot.width - spot.x;
+            let sy = (1.0 - ndc.y) * 0.5 * spot.height - spot.y;
+            if sx * sx + sy * sy <= r2 && best.is_none_or(|(_, z)| ndc.z < z) {
+                best = Some((i, ndc.z));
+            }
+        }
+        best.map(|(i, _)| i)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn pick_finds_the_front_point_under_the_spot() {
+        let mut c = OrbitCamera::default();
+        c.fit(Vec3::new(-1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, 1.0));
+        let (w, h) = (400.0, 300.0);
+        // The target is at the centre of the view; the eye looks at it along some direction
+        // d: a point nearer the eye on the same ray projects to the same spot.
+        let toward_eye = (c.eye() - Vec3::ZERO).normalize() * 0.5;
+        let xyz = [
+            0.9,
+            0.9,
+            0.9, // elsewhere
+            0.0,
+            0.0,
+            0.0, // the target, behind
+            toward_eye.x,
+            toward_eye.y,
+            toward_eye.z, // in front
+        ];
+        let spot = |x, y| PickSpot {
+            x,
+            y,
+            width: w,
+            height: h,
+            radius: 4.0,
+        };
+        assert_eq!(c.pick(&xyz, spot(200.0, 150.0)), Some(2));
+        assert_eq!(c.pick(&xyz[..6], spot(201.0, 152.0)), Some(1));
+        // The corner point, at its projected position; nothing far from any point.
+        let ndc = c.view_proj(w / h).project_point3(Vec3::splat(0.9));
+        let (x, y) = ((ndc.x + 1.0) * 0.5 * w, (1.0 - ndc.y) * 0.5 * h);
+        assert_eq!(c.pick(&xyz, spot(x, y)), Some(0));
+        assert_eq!(c.pick(&xyz, spot(5.0, 5.0)), None);
+        assert_eq!(
+            c.pick(
+                &xyz,
+                PickSpot {
+                    width: 0.0,
+                    ..spot(1.0, 1.0)
+                }
+            ),
+            None
+        );
+    }
 
     #[test]
     fn fitted_box_is_in_view() {

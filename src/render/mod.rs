@@ -8,7 +8,7 @@
 pub mod buffers;
 mod camera;
 
-pub use camera::OrbitCamera;
+pub use camera::{OrbitCamera, PickSpot};
 
 #[cfg(target_arch = "wasm32")]
 mod context;

@@ -280,6 +280,11 @@ impl Renderer {
         }
     }
 
+    /// Width of the view in CSS pixels.
+    pub fn css_width(&self) -> f32 {
+        self.gpu.config.width as f32 / self.pixel_ratio
+    }
+
     /// Height of the view in CSS pixels (for panning).
     pub fn css_height(&self) -> f32 {
         self.gpu.config.height as f32 / self.pixel_ratio

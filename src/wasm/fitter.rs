@@ -7,7 +7,8 @@ use super::scan::LoadedScan;
 use crate::export;
 use crate::fem;
 use crate::fit::{
-    FitReport, FitSpec, FitStatus, Fitter as CoreFitter, IterationRecord, Method, Scheme, Shape,
+    DeviationHistogram, DeviationStats, FitReport, FitSpec, FitStatus, Fitter as CoreFitter,
+    IterationRecord, Method, Scheme, Shape,
 };
 use crate::geom::Point3;
 use crate::io;
@@ -139,6 +140,47 @@ impl From<&IterationRecord> for JsRecord {
             e_rms_pct: r.e_rms_pct,
             ms: r.ms,
             refined: r.refined,
+        }
+    }
+}
+
+/// The deviation figures as JavaScript sees them (camelCase plain object).
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct JsDeviations {
+    points: usize,
+    mean: f64,
+    sigma: f64,
+    p50: f64,
+    p90: f64,
+    p95: f64,
+    p99: f64,
+    max: f64,
+    tolerance: Option<f64>,
+    within_tolerance_pct: Option<f64>,
+    half_width: f64,
+    counts: Vec<u32>,
+    below: u32,
+    above: u32,
+}
+
+impl JsDeviations {
+    fn of(s: DeviationStats, h: DeviationHistogram) -> JsDeviations {
+        JsDeviations {
+            points: s.points,
+            mean: s.mean,
+            sigma: s.sigma,
+            p50: s.p50,
+            p90: s.p90,
+            p95: s.p95,
+            p99: s.p99,
+            max: s.max,
+            tolerance: s.tolerance,
+            within_tolerance_pct: s.within_tolerance_pct,
+            half_width: h.half_width,
+            counts: h.counts,
+            below: h.below,
+            above: h.above,
         }
     }
 }
@@ -326,6 +368,25 @@ impl Fitter {
     #[wasm_bindgen(js_name = pointErrors)]
     pub fn point_errors(&self) -> Vec<f32> {
         self.fit.point_errors().iter().map(|&d| d as f32).collect()
+    }
+
+    /// The distribution of `pointErrors()` (model units): `{points, mean, sigma, p50, p90,
+    /// p95, p99, max, tolerance, withinTolerancePct}` (percentiles of |d|; `tolerance` the
+    /// E_max tolerance in units, `null` without one) and a histogram of `bins` (1..=1024) equal
+    /// bins over `-halfWidth..halfWidth`: `counts`, lowest first, the end bins holding the
+    /// `below` / `above` points beyond the range. The same figures as the report's `deviation`.
+    #[wasm_bindgen(unchecked_return_type = "Deviation")]
+    pub fn deviations(&self, bins: usize) -> Result<JsValue, JsError> {
+        if !(1..=1024).contains(&bins) {
+            return Err(JsError::new(&format!(
+                "deviations: bins {bins} is not in 1..=1024"
+            )));
+        }
+        let f = self.fit.as_ref();
+        let errors = f.point_errors();
+        let stats = DeviationStats::of(errors, f.diagonal(), f.tolerances().max_pct);
+        let histogram = DeviationHistogram::of(errors, &stats, bins);
+        to_js(&JsDeviations::of(stats, histogram))
     }
 
     /// The data points, `x, y, z` each, in the order of `pointErrors()` (for curves: the ordered

@@ -201,6 +201,7 @@ export interface FitReportCommon {
   converged: boolean;
   status: FitStatus;
   within_tolerance_pct: number | null;
+  deviation: DeviationReport;
   reconstruction?: ReconstructionReport;
   simplification?: SimplifyReport;
   strays?: { indices: number[] };
@@ -209,6 +210,20 @@ export interface FitReportCommon {
   fit_s: number;
   total_s: number;
   history: IterationRecord[];
+}
+
+/** The report's `deviation`: the signed point deviations' figures (model units, percentiles of |d|). */
+export interface DeviationReport {
+  points: number;
+  mean: number;
+  sigma: number;
+  p50: number;
+  p90: number;
+  p95: number;
+  p99: number;
+  max: number;
+  tolerance: number | null;
+  within_tolerance_pct: number | null;
 }
 
 /** `JSON.parse(fitter.reportJson())`: set-up, final errors, times and history of a fit. */
@@ -245,4 +260,25 @@ export interface FemQuality {
 export interface FemExport {
   bytes: Uint8Array;
   quality: FemQuality;
+}
+
+/**
+ * `Fitter.deviations(bins)`: the signed errors' figures (model units; percentiles of |d|) and
+ * their histogram over -halfWidth..halfWidth (the end bins also hold the points beyond).
+ */
+export interface Deviation {
+  points: number;
+  mean: number;
+  sigma: number;
+  p50: number;
+  p90: number;
+  p95: number;
+  p99: number;
+  max: number;
+  tolerance: number | null;
+  withinTolerancePct: number | null;
+  halfWidth: number;
+  counts: number[];
+  below: number;
+  above: number;
 }

@@ -1,6 +1,6 @@
 //! The `Viewer` handle: the wgpu renderer on a canvas, driven by the page.
 
-use crate::render::Renderer;
+use crate::render::{PickSpot, Renderer};
 use wasm_bindgen::prelude::*;
 
 /// Draws points, a triangle mesh and line sets on a canvas with WebGPU or WebGL2.
@@ -89,6 +89,32 @@ impl Viewer {
     /// Zooms by a wheel `delta` (positive: farther).
     pub fn zoom(&mut self, delta: f32) {
         self.renderer.camera.zoom(delta);
+    }
+
+    /// The index of the point of `positions` (flat `x, y, z`, the points given to
+    /// `setPoints`) seen at CSS pixel `x`, `y` of the canvas: the one nearest the eye within
+    /// `radius` CSS pixels, or `undefined`. Throws when `positions` is not whole points.
+    pub fn pick(
+        &self,
+        positions: &[f32],
+        x: f32,
+        y: f32,
+        radius: f32,
+    ) -> Result<Option<u32>, JsError> {
+        if positions.len() % 3 != 0 {
+            return Err(JsError::new(&format!(
+                "pick: {} position values are not a multiple of 3",
+                positions.len()
+            )));
+        }
+        let spot = PickSpot {
+            x,
+            y,
+            width: self.renderer.css_width(),
+            height: self.renderer.css_height(),
+            radius,
+        };
+        Ok(self.renderer.camera.pick(positions, spot).map(|i| i as u32))
     }
 
     /// Frames everything shown.
