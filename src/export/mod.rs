@@ -16,7 +16,7 @@ pub use fitted::{
 };
 
 use crate::geom::Point3;
-use crate::spline::{BSplineCurve, KnotVector, SplineError};
+use crate::spline::{BSplineCurve, KnotVector, SplineError, TrimRegion};
 use thiserror::Error;
 
 /// Why geometry could not be exported.
@@ -86,6 +86,9 @@ pub struct SurfaceDesc {
     pub control_points: Vec<Point3>,
     /// Positive weights for a NURBS surface, in the same order.
     pub weights: Option<Vec<f64>>,
+    /// The part of the (u, v) domain the face covers; `None` for the whole rectangle. STEP
+    /// writes a trimmed surface as an `ADVANCED_FACE` bounded by its loops, IGES as entity 144.
+    pub trim: Option<TrimRegion>,
 }
 
 /// What one export file holds.
@@ -108,6 +111,26 @@ impl CurveDesc {
             weights: clamped.weights().map(<[f64]>::to_vec),
             closed: curve.is_closed(),
         })
+    }
+
+    /// A closed degree-1 B-spline through `n` vertices (repeating the first at the end), vertex k
+    /// at parameter k.
+    pub(crate) fn closed_polyline(points: Vec<Point3>) -> CurveDesc {
+        let n = points.len();
+        let mut knots = vec![0.0];
+        knots.extend((0..=n).map(|k| k as f64));
+        knots.push(n as f64);
+        let mut control_points = points;
+        if let Some(&first) = control_points.first() {
+            control_points.push(first);
+        }
+        CurveDesc {
+            degree: 1,
+            knots,
+            control_points,
+            weights: None,
+            closed: true,
+        }
     }
 
     /// Checks counts, finiteness, weights and knot order.
@@ -153,6 +176,7 @@ impl SurfaceDesc {
             self.num_v + self.degree_v + 1,
         )?;
         check_points(what, &self.control_points, self.weights.as_deref(), n)?;
+        self.check_trim(what)?;
         if self.degree_u == 0
             || self.degree_v == 0
             || self.num_u <= self.degree_u
@@ -192,6 +216,38 @@ impl SurfaceDesc {
             }
         }
         Ok(num / den)
+    }
+
+    /// The parameter domain, `((u0, u1), (v0, v1))`.
+    pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
+        (
+            (self.knots_u[self.degree_u], self.knots_u[self.num_u]),
+            (self.knots_v[self.degree_v], self.knots_v[self.num_v]),
+        )
+    }
+
+    /// A trim loop vertex outside the domain is an error (the writers would put the face's
+    /// boundary off the surface).
+    fn check_trim(&self, what: &str) -> Result<(), ExportError> {
+        let Some(trim) = &self.trim else {
+            return Ok(());
+        };
+        if self.knots_u.len() <= self.num_u || self.knots_v.len() <= self.num_v {
+            return Ok(());
+        }
+        let ((u0, u1), (v0, v1)) = self.domain();
+        for (k, l) in trim.loops().enumerate() {
+            if let Some(i) = l
+                .iter()
+                .position(|p| !(p[0] >= u0 && p[0] <= u1 && p[1] >= v0 && p[1] <= v1))
+            {
+                return Err(ExportError::Invalid {
+                    what: format!("{what} trim loop {k} vertex {i}"),
+                    reason: format!("({}, {}) is outside the domain", l[i][0], l[i][1]),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Control point (i, j).

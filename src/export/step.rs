@@ -3,6 +3,12 @@
 //! `GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION` attached to one product, in
 //! millimetres. Polynomial geometry uses `B_SPLINE_CURVE_WITH_KNOTS` /
 //! `B_SPLINE_SURFACE_WITH_KNOTS`; NURBS use the complex (rational) entity forms.
+//!
+//! A trimmed surface ([`SurfaceDesc::trim`]) becomes an `ADVANCED_FACE` on it, in an
+//! `OPEN_SHELL` of a `SHELL_BASED_SURFACE_MODEL` (a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION`).
+//! Each trim loop is one closed edge: a `SURFACE_CURVE` whose 3D curve is the degree-1
+//! B-spline through the surface points at the loop's vertices and whose `PCURVE` is the loop
+//! itself as a degree-1 B-spline in (u, v), both parameterised alike (vertex k at k).
 
 use super::{real, CurveDesc, ExportError, ExportModel, SurfaceDesc};
 
@@ -68,11 +74,16 @@ fn logical(b: bool) -> &'static str {
 
 fn curve(d: &mut Data, c: &CurveDesc) -> usize {
     let pts: Vec<usize> = c.control_points.iter().map(|&p| d.point(p)).collect();
+    curve_on(d, c, &pts)
+}
+
+/// The curve entity of `c` over control point entities `pts`.
+fn curve_on(d: &mut Data, c: &CurveDesc, pts: &[usize]) -> usize {
     let (values, mults) = knot_runs(&c.knots);
     let common = format!(
         "{},{},.UNSPECIFIED.,{},.F.",
         c.degree,
-        refs(&pts),
+        refs(pts),
         logical(c.closed)
     );
     let knots = format!("{},{},.UNSPECIFIED.", ints(&mults), reals(&values));
@@ -123,6 +134,45 @@ fn surface(d: &mut Data, s: &SurfaceDesc) -> usize {
     }
 }
 
+/// The face of trimmed surface `s` (entity `surf`), its loops' parameter curves in the 2D
+/// context `ctx2`.
+fn trimmed_face(
+    d: &mut Data,
+    s: &SurfaceDesc,
+    trim: &crate::spline::TrimRegion,
+    surf: usize,
+    ctx2: usize,
+) -> Result<usize, ExportError> {
+    let mut bounds = Vec::new();
+    for (k, l) in trim.loops().enumerate() {
+        let flat: Vec<_> = l.iter().map(|p| crate::geom::Point3::new(p[0], p[1], 0.0)).collect();
+        let uv = CurveDesc::closed_polyline(flat);
+        let pts2: Vec<usize> = uv
+            .control_points
+            .iter()
+            .map(|p| d.add(format!("CARTESIAN_POINT('',({},{}))", real(p.x), real(p.y))))
+            .collect();
+        let c2 = curve_on(d, &uv, &pts2);
+        let rep = d.add(format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx2})"));
+        let pcurve = d.add(format!("PCURVE('',#{surf},#{rep})"));
+        let image = l
+            .iter()
+            .map(|p| s.eval(p[0], p[1]))
+            .collect::<Result<Vec<_>, _>>()?;
+        let c3 = curve(d, &CurveDesc::closed_polyline(image));
+        let sc = d.add(format!("SURFACE_CURVE('',#{c3},(#{pcurve}),.PCURVE_S1.)"));
+        let start = s.eval(l[0][0], l[0][1])?;
+        let p = d.point(start);
+        let v = d.add(format!("VERTEX_POINT('',#{p})"));
+        let e = d.add(format!("EDGE_CURVE('',#{v},#{v},#{sc},.T.)"));
+        let oe = d.add(format!("ORIENTED_EDGE('',*,*,#{e},.T.)"));
+        let el = d.add(format!("EDGE_LOOP('',(#{oe}))"));
+        let kind = if k == 0 { "FACE_OUTER_BOUND" } else { "FACE_BOUND" };
+        bounds.push(d.add(format!("{kind}('',#{el},.T.)")));
+    }
+    Ok(d.add(format!("ADVANCED_FACE('',{},#{surf},.T.)", refs(&bounds))))
+}
+
 /// The STEP text of `model`; `name` goes into the header and the product.
 pub fn write_step(model: &ExportModel, name: &str) -> Result<String, ExportError> {
     model.validate()?;
@@ -154,12 +204,39 @@ pub fn write_step(model: &ExportModel, name: &str) -> Result<String, ExportError
          GLOBAL_UNIT_ASSIGNED_CONTEXT((#{len},#{ang},#{sol}))REPRESENTATION_CONTEXT('',''))"
     ));
     let mut items: Vec<usize> = model.curves.iter().map(|c| curve(&mut d, c)).collect();
-    items.extend(model.surfaces.iter().map(|s| surface(&mut d, s)));
-    let set = d.add(format!("GEOMETRIC_SET('',{})", refs(&items)));
-    let rep = d.add(format!(
-        "GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION('{name}',(#{set}),#{ctx})"
-    ));
-    d.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    let mut faces = Vec::new();
+    let mut ctx2 = None;
+    for s in &model.surfaces {
+        let surf = surface(&mut d, s);
+        match &s.trim {
+            None => items.push(surf),
+            Some(trim) => {
+                let c2 = *ctx2.get_or_insert_with(|| {
+                    d.add(
+                        "(GEOMETRIC_REPRESENTATION_CONTEXT(2)PARAMETRIC_REPRESENTATION_CONTEXT()\
+                         REPRESENTATION_CONTEXT('2D SPACE',''))"
+                            .into(),
+                    )
+                });
+                faces.push(trimmed_face(&mut d, s, trim, surf, c2)?);
+            }
+        }
+    }
+    if !faces.is_empty() {
+        let shell = d.add(format!("OPEN_SHELL('',{})", refs(&faces)));
+        let model = d.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"));
+        let rep = d.add(format!(
+            "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('{name}',(#{model}),#{ctx})"
+        ));
+        d.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    }
+    if !items.is_empty() || faces.is_empty() {
+        let set = d.add(format!("GEOMETRIC_SET('',{})", refs(&items)));
+        let rep = d.add(format!(
+            "GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION('{name}',(#{set}),#{ctx})"
+        ));
+        d.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    }
     let mut out = String::from("ISO-10303-21;\nHEADER;\n");
     out.push_str("FILE_DESCRIPTION(('geofit B-spline export'),'2;1');\n");
     out.push_str(&format!(

@@ -47,6 +47,7 @@ pub use subdiv::{
     SubdivFitOptions, SubdivFitter, Weighting,
 };
 pub use surface::{
+    SurfaceTrim,
     energies, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
     GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, Parameterization,
     SurfaceGrid, TolMode,
