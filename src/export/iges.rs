@@ -12,7 +12,6 @@
 //! to the entity's directory entry.
 
 use super::{real, CurveDesc, ExportError, ExportModel, SurfaceDesc};
-use crate::geom::Point3;
 
 /// Fixed date stamp, so the same geometry always gives the same file.
 const DATE: &str = "20260101.000000";
@@ -106,12 +105,8 @@ fn trimmed_surface(
     let surf = e.add(128, surface_params(s), DEPENDENT);
     let mut bounds = Vec::new();
     for l in trim.loops() {
-        let flat = l.iter().map(|p| Point3::new(p[0], p[1], 0.0)).collect();
+        let (flat, image) = s.trim_loop(l)?;
         let uv = e.add(126, curve_params(&CurveDesc::closed_polyline(flat)), PARAMETRIC);
-        let image = l
-            .iter()
-            .map(|p| s.eval(p[0], p[1]))
-            .collect::<Result<Vec<_>, _>>()?;
         let model = e.add(
             126,
             curve_params(&CurveDesc::closed_polyline(image)),

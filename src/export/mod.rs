@@ -250,6 +250,39 @@ impl SurfaceDesc {
         Ok(())
     }
 
+    /// A trim loop as the writers put it: its vertices in (u, v) (z = 0) and their surface
+    /// points, with vertices added along an edge wherever the chord between the surface points
+    /// strays from the surface by more than 1e-5 of the control grid's diagonal, so the 3D
+    /// polyline and the (u, v) polyline on the surface agree parameter by parameter.
+    pub(crate) fn trim_loop(&self, l: &[[f64; 2]]) -> Result<(Vec<Point3>, Vec<Point3>), ExportError> {
+        let (lo, hi) = self.control_points.iter().fold(
+            (Point3::splat(f64::INFINITY), Point3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let tol = 1e-5 * (hi - lo).length();
+        let (mut uv, mut xyz) = (Vec::new(), Vec::new());
+        for k in 0..l.len() {
+            let (a, b) = (l[k], l[(k + 1) % l.len()]);
+            let mut stack = vec![(0.0, 1.0, self.eval(a[0], a[1])?, self.eval(b[0], b[1])?)];
+            // Depth-first, the first half first, so the vertices come out in order.
+            while let Some((t0, t1, p0, p1)) = stack.pop() {
+                let tm = (t0 + t1) / 2.0;
+                let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+                let m = at(tm);
+                let pm = self.eval(m[0], m[1])?;
+                if (pm - (p0 + p1) / 2.0).length() > tol && t1 - t0 > 1.0 / 64.0 {
+                    stack.push((tm, t1, pm, p1));
+                    stack.push((t0, tm, p0, pm));
+                } else {
+                    let s = at(t0);
+                    uv.push(Point3::new(s[0], s[1], 0.0));
+                    xyz.push(p0);
+                }
+            }
+        }
+        Ok((uv, xyz))
+    }
+
     /// Control point (i, j).
     pub fn point(&self, i: usize, j: usize) -> Point3 {
         self.control_points[i * self.num_v + j]

@@ -145,7 +145,8 @@ fn trimmed_face(
 ) -> Result<usize, ExportError> {
     let mut bounds = Vec::new();
     for (k, l) in trim.loops().enumerate() {
-        let flat: Vec<_> = l.iter().map(|p| crate::geom::Point3::new(p[0], p[1], 0.0)).collect();
+        let (flat, image) = s.trim_loop(l)?;
+        let start = image[0];
         let uv = CurveDesc::closed_polyline(flat);
         let pts2: Vec<usize> = uv
             .control_points
@@ -155,13 +156,8 @@ fn trimmed_face(
         let c2 = curve_on(d, &uv, &pts2);
         let rep = d.add(format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx2})"));
         let pcurve = d.add(format!("PCURVE('',#{surf},#{rep})"));
-        let image = l
-            .iter()
-            .map(|p| s.eval(p[0], p[1]))
-            .collect::<Result<Vec<_>, _>>()?;
         let c3 = curve(d, &CurveDesc::closed_polyline(image));
         let sc = d.add(format!("SURFACE_CURVE('',#{c3},(#{pcurve}),.PCURVE_S1.)"));
-        let start = s.eval(l[0][0], l[0][1])?;
         let p = d.point(start);
         let v = d.add(format!("VERTEX_POINT('',#{p})"));
         let e = d.add(format!("EDGE_CURVE('',#{v},#{v},#{sc},.T.)"));

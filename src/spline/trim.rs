@@ -292,12 +292,38 @@ fn boundary_loops(dt: &DelaunayTriangulation<Param>, kept: &[bool]) -> Vec<Vec<[
                 };
                 (prev, cur) = (cur, next);
             }
-            if l.len() >= 3 {
-                loops.push(l.iter().map(|&i| positions[i]).collect());
+            for simple in split_pinches(&l) {
+                loops.push(simple.iter().map(|&i| positions[i]).collect());
             }
         }
     }
     loops
+}
+
+/// The simple loops a loop that visits some vertices more than once (where parts of the region
+/// touch at a point) is made of, each of three vertices or more: CAD readers take a wire that
+/// touches itself for a wrong one.
+fn split_pinches(l: &[usize]) -> Vec<Vec<usize>> {
+    let mut out = Vec::new();
+    let mut stack: Vec<usize> = Vec::new();
+    let mut at: HashMap<usize, usize> = HashMap::new();
+    for &v in l {
+        if let Some(&p) = at.get(&v) {
+            let sub: Vec<usize> = stack.drain(p..).collect();
+            for w in &sub {
+                at.remove(w);
+            }
+            if sub.len() >= 3 {
+                out.push(sub);
+            }
+        }
+        at.insert(v, stack.len());
+        stack.push(v);
+    }
+    if stack.len() >= 3 {
+        out.push(stack);
+    }
+    out
 }
 
 /// Takes the boundary edge out of `cur` first clockwise from the direction back to `prev`.
@@ -333,7 +359,7 @@ fn classify(
     let tol = options.simplify_factor * spacing;
     let holes: Vec<Vec<[f64; 2]>> = inners
         .into_iter()
-        .filter(|h| -signed_area(h) > min_hole && crosses(&outer, h[0][0], h[0][1]))
+        .filter(|h| -signed_area(h) > min_hole && inside(&outer, h))
         .map(|h| simplify_loop(&h, tol))
         .collect();
     let dropped = total - 1 - holes.len();
@@ -342,6 +368,11 @@ fn classify(
         holes,
     };
     Some((region, dropped))
+}
+
+/// Whether most vertices of `h` lie inside `outer` (a hole may touch it at a vertex).
+fn inside(outer: &[[f64; 2]], h: &[[f64; 2]]) -> bool {
+    2 * h.iter().filter(|p| crosses(outer, p[0], p[1])).count() > h.len()
 }
 
 /// Shoelace area, positive for counter-clockwise loops.
