@@ -403,15 +403,21 @@ fn crosses(l: &[[f64; 2]], u: f64, v: f64) -> bool {
     inside
 }
 
-/// Douglas–Peucker on a closed loop, split at its first vertex and the vertex farthest from
-/// it; loops that would fall below three vertices stay as they are.
+/// Douglas–Peucker on a closed loop, split at two extreme vertices (the one farthest from the
+/// first vertex, and the one farthest from that), which any simplification keeps; loops that
+/// would fall below three vertices stay as they are.
 fn simplify_loop(l: &[[f64; 2]], tol: f64) -> Vec<[f64; 2]> {
     let dist_sq = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-    let far = (0..l.len())
-        .max_by(|&a, &b| dist_sq(l[0], l[a]).total_cmp(&dist_sq(l[0], l[b])))
-        .unwrap_or(0);
+    let farthest = |l: &[[f64; 2]]| {
+        (0..l.len())
+            .max_by(|&a, &b| dist_sq(l[0], l[a]).total_cmp(&dist_sq(l[0], l[b])))
+            .unwrap_or(0)
+    };
+    let start = farthest(l);
+    let l: Vec<[f64; 2]> = l[start..].iter().chain(&l[..start]).copied().collect();
+    let far = farthest(&l);
     if far == 0 {
-        return l.to_vec();
+        return l;
     }
     let mut keep = vec![false; l.len()];
     keep[0] = true;
@@ -423,7 +429,7 @@ fn simplify_loop(l: &[[f64; 2]], tol: f64) -> Vec<[f64; 2]> {
     if out.len() >= 3 {
         out
     } else {
-        l.to_vec()
+        l
     }
 }
 
