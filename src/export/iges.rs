@@ -106,10 +106,10 @@ fn trimmed_surface(
     let mut bounds = Vec::new();
     for l in trim.loops() {
         let (flat, image) = s.trim_loop(l)?;
-        let uv = e.add(126, curve_params(&CurveDesc::closed_polyline(flat)), PARAMETRIC);
+        let uv = e.add(126, curve_params(&CurveDesc::polyline(flat, true)), PARAMETRIC);
         let model = e.add(
             126,
-            curve_params(&CurveDesc::closed_polyline(image)),
+            curve_params(&CurveDesc::polyline(image, true)),
             DEPENDENT,
         );
         let fields = ["142", "0", &surf.to_string(), &uv.to_string(), &model.to_string(), "1"];

@@ -113,23 +113,24 @@ impl CurveDesc {
         })
     }
 
-    /// A closed degree-1 B-spline through `n` vertices (repeating the first at the end), vertex k
-    /// at parameter k.
-    pub(crate) fn closed_polyline(points: Vec<Point3>) -> CurveDesc {
-        let n = points.len();
-        let mut knots = vec![0.0];
-        knots.extend((0..=n).map(|k| k as f64));
-        knots.push(n as f64);
-        let mut control_points = points;
-        if let Some(&first) = control_points.first() {
-            control_points.push(first);
+    /// The degree-1 B-spline through `points`, vertex k at parameter k; a closed one repeats
+    /// the first vertex at the end.
+    pub(crate) fn polyline(mut points: Vec<Point3>, closed: bool) -> CurveDesc {
+        if closed {
+            if let Some(&first) = points.first() {
+                points.push(first);
+            }
         }
+        let m = points.len().saturating_sub(1);
+        let mut knots = vec![0.0];
+        knots.extend((0..=m).map(|k| k as f64));
+        knots.push(m as f64);
         CurveDesc {
             degree: 1,
             knots,
-            control_points,
+            control_points: points,
             weights: None,
-            closed: true,
+            closed,
         }
     }
 

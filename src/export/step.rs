@@ -6,9 +6,10 @@
 //!
 //! A trimmed surface ([`SurfaceDesc::trim`]) becomes an `ADVANCED_FACE` on it, in an
 //! `OPEN_SHELL` of a `SHELL_BASED_SURFACE_MODEL` (a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION`).
-//! Each trim loop is one closed edge: a `SURFACE_CURVE` whose 3D curve is the degree-1
-//! B-spline through the surface points at the loop's vertices and whose `PCURVE` is the loop
-//! itself as a degree-1 B-spline in (u, v), both parameterised alike (vertex k at k).
+//! Each trim loop is an `EDGE_LOOP` of four edges, each a `SURFACE_CURVE` whose 3D curve is the
+//! degree-1 B-spline through the surface points at the loop's vertices and whose `PCURVE` is
+//! that stretch of the loop as a degree-1 B-spline in (u, v), both parameterised alike (vertex
+//! k at k).
 
 use super::{real, CurveDesc, ExportError, ExportModel, SurfaceDesc};
 
@@ -134,6 +135,10 @@ fn surface(d: &mut Data, s: &SurfaceDesc) -> usize {
     }
 }
 
+/// Edges a trim loop is cut into: OCCT's area integration mishandles a loop that is one
+/// closed edge (the tessellation was right, `BRepGProp` was not).
+const EDGES_PER_LOOP: usize = 4;
+
 /// The face of trimmed surface `s` (entity `surf`), its loops' parameter curves in the 2D
 /// context `ctx2`.
 fn trimmed_face(
@@ -146,23 +151,38 @@ fn trimmed_face(
     let mut bounds = Vec::new();
     for (k, l) in trim.loops().enumerate() {
         let (flat, image) = s.trim_loop(l)?;
-        let start = image[0];
-        let uv = CurveDesc::closed_polyline(flat);
-        let pts2: Vec<usize> = uv
-            .control_points
+        let n = flat.len();
+        let pieces = n.min(EDGES_PER_LOOP);
+        let cuts: Vec<usize> = (0..=pieces).map(|j| j * n / pieces).collect();
+        let vertices: Vec<usize> = cuts[..pieces]
             .iter()
-            .map(|p| d.add(format!("CARTESIAN_POINT('',({},{}))", real(p.x), real(p.y))))
+            .map(|&c| {
+                let p = d.point(image[c]);
+                d.add(format!("VERTEX_POINT('',#{p})"))
+            })
             .collect();
-        let c2 = curve_on(d, &uv, &pts2);
-        let rep = d.add(format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx2})"));
-        let pcurve = d.add(format!("PCURVE('',#{surf},#{rep})"));
-        let c3 = curve(d, &CurveDesc::closed_polyline(image));
-        let sc = d.add(format!("SURFACE_CURVE('',#{c3},(#{pcurve}),.PCURVE_S1.)"));
-        let p = d.point(start);
-        let v = d.add(format!("VERTEX_POINT('',#{p})"));
-        let e = d.add(format!("EDGE_CURVE('',#{v},#{v},#{sc},.T.)"));
-        let oe = d.add(format!("ORIENTED_EDGE('',*,*,#{e},.T.)"));
-        let el = d.add(format!("EDGE_LOOP('',(#{oe}))"));
+        let mut edges = Vec::new();
+        for j in 0..pieces {
+            let range: Vec<usize> = (cuts[j]..=cuts[j + 1]).map(|i| i % n).collect();
+            let uv = CurveDesc::polyline(range.iter().map(|&i| flat[i]).collect(), false);
+            let pts2: Vec<usize> = uv
+                .control_points
+                .iter()
+                .map(|p| d.add(format!("CARTESIAN_POINT('',({},{}))", real(p.x), real(p.y))))
+                .collect();
+            let c2 = curve_on(d, &uv, &pts2);
+            let rep = d.add(format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx2})"));
+            let pcurve = d.add(format!("PCURVE('',#{surf},#{rep})"));
+            let c3 = curve(
+                d,
+                &CurveDesc::polyline(range.iter().map(|&i| image[i]).collect(), false),
+            );
+            let sc = d.add(format!("SURFACE_CURVE('',#{c3},(#{pcurve}),.PCURVE_S1.)"));
+            let (v0, v1) = (vertices[j], vertices[(j + 1) % pieces]);
+            let e = d.add(format!("EDGE_CURVE('',#{v0},#{v1},#{sc},.T.)"));
+            edges.push(d.add(format!("ORIENTED_EDGE('',*,*,#{e},.T.)")));
+        }
+        let el = d.add(format!("EDGE_LOOP('',{})", refs(&edges)));
         let kind = if k == 0 { "FACE_OUTER_BOUND" } else { "FACE_BOUND" };
         bounds.push(d.add(format!("{kind}('',#{el},.T.)")));
     }
