@@ -154,7 +154,10 @@ fn step_and_iges_carry_the_trim() {
         .map(|l| l[..8].trim())
         .collect();
     // 128, then per loop a (u, v) 126, a 3D 126 and a 142, then the 144.
-    assert_eq!(kinds, ["128", "126", "126", "142", "126", "126", "142", "144"]);
+    assert_eq!(
+        kinds,
+        ["128", "126", "126", "142", "126", "126", "142", "144"]
+    );
     assert!(iges.lines().all(|l| l.len() == 80));
     // Untrimmed: the bare surface as before.
     let plain = write_step(&trimmed_patch(None), "plain").unwrap();

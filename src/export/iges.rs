@@ -106,13 +106,24 @@ fn trimmed_surface(
     let mut bounds = Vec::new();
     for l in trim.loops() {
         let (flat, image) = s.trim_loop(l)?;
-        let uv = e.add(126, curve_params(&CurveDesc::polyline(flat, true)), PARAMETRIC);
+        let uv = e.add(
+            126,
+            curve_params(&CurveDesc::polyline(flat, true)),
+            PARAMETRIC,
+        );
         let model = e.add(
             126,
             curve_params(&CurveDesc::polyline(image, true)),
             DEPENDENT,
         );
-        let fields = ["142", "0", &surf.to_string(), &uv.to_string(), &model.to_string(), "1"];
+        let fields = [
+            "142",
+            "0",
+            &surf.to_string(),
+            &uv.to_string(),
+            &model.to_string(),
+            "1",
+        ];
         bounds.push(e.add(
             142,
             terminate(fields.iter().map(|f| f.to_string()).collect()),

@@ -255,9 +255,15 @@ impl SurfaceDesc {
     /// points, with vertices added along an edge wherever the chord between the surface points
     /// strays from the surface by more than 1e-5 of the control grid's diagonal, so the 3D
     /// polyline and the (u, v) polyline on the surface agree parameter by parameter.
-    pub(crate) fn trim_loop(&self, l: &[[f64; 2]]) -> Result<(Vec<Point3>, Vec<Point3>), ExportError> {
+    pub(crate) fn trim_loop(
+        &self,
+        l: &[[f64; 2]],
+    ) -> Result<(Vec<Point3>, Vec<Point3>), ExportError> {
         let (lo, hi) = self.control_points.iter().fold(
-            (Point3::splat(f64::INFINITY), Point3::splat(f64::NEG_INFINITY)),
+            (
+                Point3::splat(f64::INFINITY),
+                Point3::splat(f64::NEG_INFINITY),
+            ),
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         );
         let tol = 1e-5 * (hi - lo).length();

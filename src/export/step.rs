@@ -183,7 +183,11 @@ fn trimmed_face(
             edges.push(d.add(format!("ORIENTED_EDGE('',*,*,#{e},.T.)")));
         }
         let el = d.add(format!("EDGE_LOOP('',{})", refs(&edges)));
-        let kind = if k == 0 { "FACE_OUTER_BOUND" } else { "FACE_BOUND" };
+        let kind = if k == 0 {
+            "FACE_OUTER_BOUND"
+        } else {
+            "FACE_BOUND"
+        };
         bounds.push(d.add(format!("{kind}('',#{el},.T.)")));
     }
     Ok(d.add(format!("ADVANCED_FACE('',{},#{surf},.T.)", refs(&bounds))))

@@ -47,10 +47,9 @@ pub use subdiv::{
     SubdivFitOptions, SubdivFitter, Weighting,
 };
 pub use surface::{
-    SurfaceTrim,
     energies, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
     GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, Parameterization,
-    SurfaceGrid, TolMode,
+    SurfaceGrid, SurfaceTrim, TolMode,
 };
 
 use crate::geom::Point3;

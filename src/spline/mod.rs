@@ -16,5 +16,5 @@ pub use chaikin::ChaikinCurve;
 pub use curve::{BSplineCurve, CurveBasis, MAX_CURVE_DEGREE, MAX_DERIV};
 pub use error::SplineError;
 pub use knots::{KnotVector, MAX_DEGREE};
-pub use trim::{Outline, TrimError, TrimOptions, TrimRegion};
 pub use surface::{BSplineSurface, SurfaceBasis, SurfaceDerivs, MAX_SURFACE_DERIV};
+pub use trim::{Outline, TrimError, TrimOptions, TrimRegion};

@@ -170,7 +170,10 @@ impl TrimRegion {
                 found: params.len(),
             });
         }
-        if let Some(index) = params.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+        if let Some(index) = params
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
             return Err(TrimError::NotFinite { index });
         }
         let degenerate = TrimError::Degenerate {
@@ -236,7 +239,10 @@ fn check_loop(what: &str, l: &[[f64; 2]]) -> Result<(), TrimError> {
     if l.len() < 3 {
         return bad(format!("{} vertices, at least 3 needed", l.len()));
     }
-    if let Some(i) = l.iter().position(|p| !(p[0].is_finite() && p[1].is_finite())) {
+    if let Some(i) = l
+        .iter()
+        .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+    {
         return bad(format!("vertex {i} is not finite"));
     }
     if signed_area(l) == 0.0 {

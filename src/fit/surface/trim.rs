@@ -39,7 +39,13 @@ impl SurfaceTrim {
         let data_area = outline
             .triangles
             .iter()
-            .filter_map(|t| Some(triangle_area(*data.get(t[0])?, *data.get(t[1])?, *data.get(t[2])?)))
+            .filter_map(|t| {
+                Some(triangle_area(
+                    *data.get(t[0])?,
+                    *data.get(t[1])?,
+                    *data.get(t[2])?,
+                ))
+            })
             .sum();
         Ok(SurfaceTrim {
             trimmed_area: trimmed_area(surface, &outline.region),
