@@ -363,14 +363,19 @@ fn classify(
         .max_by(|a, b| signed_area(a).total_cmp(&signed_area(b)))?;
     let min_hole = (options.hole_factor * spacing).powi(2);
     let tol = options.simplify_factor * spacing;
+    let simple_outer = simplify_loop(&outer, tol);
+    // A hole touching the outer loop at a vertex, or whose simplified loop strays outside the
+    // simplified outer one, would make the face's wires meet: it is filled instead.
     let holes: Vec<Vec<[f64; 2]>> = inners
         .into_iter()
         .filter(|h| -signed_area(h) > min_hole && inside(&outer, h))
+        .filter(|h| !h.iter().any(|p| outer.contains(p)))
         .map(|h| simplify_loop(&h, tol))
+        .filter(|h| h.iter().all(|p| crosses(&simple_outer, p[0], p[1])))
         .collect();
     let dropped = total - 1 - holes.len();
     let region = TrimRegion {
-        outer: simplify_loop(&outer, tol),
+        outer: simple_outer,
         holes,
     };
     Some((region, dropped))

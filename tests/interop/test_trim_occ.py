@@ -5,9 +5,9 @@ Fits a B-spline surface with `geofit fit --scheme bspline-surface` to bun000.ply
 range scan with holes) and to a synthetic height field with a round hole, exports STEP and IGES,
 reads both back with OCC and checks: one face, and its area (BRepGProp.SurfaceProperties,
 adaptive to 1e-6) within 5 % of the data's triangulated region (`trim.data_area` of the fit
-report: the outline's Delaunay triangles with the data points at their corners). BRepCheck
-validity is printed and required for the synthetic patch; bun000's face is not valid yet (see
-docs/trim.md).
+report: the outline's Delaunay triangles with the data points at their corners), and
+BRepCheck_Analyzer finds the face valid. A third case, the patch without its hole, is data
+covering the whole domain: the trim follows the domain's edges and the face stays valid.
 
 Run: python tests/interop/test_trim_occ.py   (exit status 1 on any failure)
 Uses $GEOFIT_BIN, else target/release/geofit (built with cargo if missing).
@@ -56,13 +56,13 @@ def area(shape):
     return props.Mass()
 
 
-def hole_patch(path):
-    """A 61 × 61 grid over 100 × 80 on a smooth height field, without a disc of radius 15."""
+def patch(path, hole):
+    """A 61 × 61 grid over 100 × 80 on a smooth height field, without a disc of radius `hole`."""
     with open(path, "w") as f:
         for i in range(61):
             for j in range(61):
                 x, y = i / 60 * 100, j / 60 * 80
-                if (x - 50) ** 2 + (y - 40) ** 2 < 15 ** 2:
+                if (x - 50) ** 2 + (y - 40) ** 2 < hole ** 2:
                     continue
                 f.write(f"{x} {y} {5 * math.sin(x / 30) + 3 * math.cos(y / 25)}\n")
 
@@ -72,10 +72,11 @@ def main():
     failures = 0
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        hole_patch(tmp / "hole.xyz")
-        cases = [("bun000", REPO.parent / "shared" / "data" / "bun000.ply", False),
-                 ("hole-patch", tmp / "hole.xyz", True)]
-        for name, data, need_valid in cases:
+        patch(tmp / "hole.xyz", 15)
+        patch(tmp / "full.xyz", 0)
+        cases = [("bun000", REPO.parent / "shared" / "data" / "bun000.ply"),
+                 ("hole-patch", tmp / "hole.xyz"), ("full-patch", tmp / "full.xyz")]
+        for name, data in cases:
             out = tmp / name
             subprocess.run([exe, "fit", str(data), "--scheme", "bspline-surface", "--quiet",
                             "--step", f"{out}.stp", "--iges", f"{out}.igs", "--json", f"{out}.json"],
@@ -85,7 +86,7 @@ def main():
                 shape = read_shape(Path(f"{out}{ext}"))
                 a, valid, n = area(shape), BRepCheck_Analyzer(shape).IsValid(), faces(shape)
                 rel = a / trim["data_area"] - 1
-                ok = n == 1 and abs(rel) <= AREA_TOL and (valid or not need_valid)
+                ok = n == 1 and abs(rel) <= AREA_TOL and valid
                 failures += not ok
                 print(f"{'ok  ' if ok else 'FAIL'} {name}{ext}: {n} face, valid {valid}, area {a:.6g} "
                       f"vs data {trim['data_area']:.6g} ({100 * rel:+.2f} %), "
