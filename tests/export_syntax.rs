@@ -35,6 +35,7 @@ fn model() -> ExportModel {
         num_v: 5,
         control_points: grid,
         weights: Some((0..20).map(|k| 1.0 + (k % 3) as f64 * 0.25).collect()),
+        trim: None,
     };
     ExportModel {
         curves: [open, closed, rational]

@@ -3,11 +3,11 @@
 //! refuse the same exports with the same messages.
 
 use super::{iges::write_iges, step::write_step, CurveDesc, ExportError, ExportModel, SurfaceDesc};
-use crate::fit::{FitReport, Fitter, Scheme, Shape, Spline};
+use crate::fit::{FitReport, Fitter, Scheme, Shape, Spline, SurfaceTrim};
 use crate::geom::Point3;
 use crate::io::{to_glb_bytes, GlbOptions};
 use crate::mesh::PolyMesh;
-use crate::spline::BSplineSurface;
+use crate::spline::{BSplineSurface, TrimOptions};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 
@@ -41,16 +41,23 @@ impl SurfaceDesc {
             num_v,
             control_points: s.control_points().to_vec(),
             weights: s.weights().map(<[f64]>::to_vec),
+            trim: None,
         }
     }
 }
 
-/// The fitted spline of `fit` as an export model; subdivision surfaces have none.
+/// The fitted spline of `fit` as an export model; subdivision surfaces have none. A surface is
+/// trimmed to its data ([`SurfaceTrim`]); where the data give no region (too few points, all
+/// on a line) it stays the whole rectangle, and the fit report's `trim` says why.
 pub fn cad_model(fit: &dyn Fitter) -> Result<ExportModel, ExportError> {
     let mut model = ExportModel::default();
     match fit.spline() {
-        Some(Spline::Surface { surface, .. }) => {
-            model.surfaces.push(SurfaceDesc::from_surface(surface))
+        Some(Spline::Surface { surface, params }) => {
+            let mut desc = SurfaceDesc::from_surface(surface);
+            desc.trim = SurfaceTrim::of(surface, params, fit.data(), &TrimOptions::default())
+                .ok()
+                .map(|t| t.region);
+            model.surfaces.push(desc)
         }
         Some(Spline::Curve { curve, .. }) => model.curves.push(CurveDesc::from_curve(curve)?),
         None => {

@@ -1,4 +1,11 @@
-//! IGES 5.3 writer: rational B-spline curves (entity 126) and surfaces (entity 128).
+//! IGES 5.3 writer: rational B-spline curves (entity 126) and surfaces (entity 128), trimmed
+//! surfaces (entity 144).
+//!
+//! A trimmed surface is a 144 over its 128, with one 142 (curve on a parametric surface) per
+//! trim loop; each 142 points to the loop as a planar degree-1 126 in (u, v) (z = 0, the
+//! preferred representation) and to its image, the degree-1 126 through the surface points at
+//! the loop's vertices. The surface and the curves are marked physically dependent, so readers
+//! transfer the trimmed face only.
 //!
 //! Fixed 80-column records: columns 1–72 data, 73 the section letter (S, G, D, P, T), 74–80 the
 //! sequence number. Parameter records keep columns 1–64 for data and 66–72 for the pointer back
@@ -15,16 +22,21 @@ pub fn write_iges(model: &ExportModel, name: &str) -> Result<String, ExportError
     let mut out = String::new();
     let start = section_lines(&["geofit B-spline export".to_string()], 72, 'S');
     let global = section_lines(&global_params(model, name), 72, 'G');
-    let mut entities: Vec<(u32, Vec<String>)> = Vec::new();
+    let mut entities = Entities::default();
     for c in &model.curves {
-        entities.push((126, curve_params(c)));
+        entities.add(126, curve_params(c), INDEPENDENT);
     }
     for s in &model.surfaces {
-        entities.push((128, surface_params(s)));
+        match &s.trim {
+            None => {
+                entities.add(128, surface_params(s), INDEPENDENT);
+            }
+            Some(trim) => trimmed_surface(&mut entities, s, trim)?,
+        }
     }
     let mut directory = Vec::new();
     let mut params = Vec::new();
-    for (k, (kind, tokens)) in entities.iter().enumerate() {
+    for (k, (kind, tokens, status)) in entities.list.iter().enumerate() {
         let de = 2 * k + 1;
         let lines = wrap(tokens, 64);
         let first = params.len() + 1;
@@ -33,7 +45,7 @@ pub fn write_iges(model: &ExportModel, name: &str) -> Result<String, ExportError
         }
         directory.push(format!(
             "{kind:>8}{first:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}D{:>7}",
-            0, 0, 0, 0, 0, 0, "00000000", de
+            0, 0, 0, 0, 0, 0, status, de
         ));
         directory.push(format!(
             "{kind:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}D{:>7}",
@@ -61,6 +73,72 @@ pub fn write_iges(model: &ExportModel, name: &str) -> Result<String, ExportError
     );
     out.push_str(&format!("{counts:<72}T{:>7}\n", 1));
     Ok(out)
+}
+
+/// Directory status of an entity that stands alone.
+const INDEPENDENT: &str = "00000000";
+/// Directory status of an entity another one is made of (physically dependent).
+const DEPENDENT: &str = "00010000";
+/// Directory status of a curve in a surface's parameter space (dependent, 2D parametric use).
+const PARAMETRIC: &str = "00010500";
+
+/// Entities in directory order: type number, parameter tokens, status.
+#[derive(Default)]
+struct Entities {
+    list: Vec<(u32, Vec<String>, &'static str)>,
+}
+
+impl Entities {
+    /// Adds an entity and returns the sequence number of its directory entry.
+    fn add(&mut self, kind: u32, params: Vec<String>, status: &'static str) -> usize {
+        self.list.push((kind, params, status));
+        2 * self.list.len() - 1
+    }
+}
+
+/// Entity 144 over `s` bounded by `trim`, with the 128, 142 and 126 entities it refers to.
+fn trimmed_surface(
+    e: &mut Entities,
+    s: &SurfaceDesc,
+    trim: &crate::spline::TrimRegion,
+) -> Result<(), ExportError> {
+    let surf = e.add(128, surface_params(s), DEPENDENT);
+    let mut bounds = Vec::new();
+    for l in trim.loops() {
+        let (flat, image) = s.trim_loop(l)?;
+        let uv = e.add(
+            126,
+            curve_params(&CurveDesc::polyline(flat, true)),
+            PARAMETRIC,
+        );
+        let model = e.add(
+            126,
+            curve_params(&CurveDesc::polyline(image, true)),
+            DEPENDENT,
+        );
+        let fields = [
+            "142",
+            "0",
+            &surf.to_string(),
+            &uv.to_string(),
+            &model.to_string(),
+            "1",
+        ];
+        bounds.push(e.add(
+            142,
+            terminate(fields.iter().map(|f| f.to_string()).collect()),
+            DEPENDENT,
+        ));
+    }
+    let mut fields = vec![
+        "144".to_string(),
+        surf.to_string(),
+        "1".into(),
+        bounds.len().saturating_sub(1).to_string(),
+    ];
+    fields.extend(bounds.iter().map(|b| b.to_string()));
+    e.add(144, terminate(fields), INDEPENDENT);
+    Ok(())
 }
 
 /// A Hollerith string `nHtext`.

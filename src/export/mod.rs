@@ -16,7 +16,7 @@ pub use fitted::{
 };
 
 use crate::geom::Point3;
-use crate::spline::{BSplineCurve, KnotVector, SplineError};
+use crate::spline::{BSplineCurve, KnotVector, SplineError, TrimRegion};
 use thiserror::Error;
 
 /// Why geometry could not be exported.
@@ -86,6 +86,9 @@ pub struct SurfaceDesc {
     pub control_points: Vec<Point3>,
     /// Positive weights for a NURBS surface, in the same order.
     pub weights: Option<Vec<f64>>,
+    /// The part of the (u, v) domain the face covers; `None` for the whole rectangle. STEP
+    /// writes a trimmed surface as an `ADVANCED_FACE` bounded by its loops, IGES as entity 144.
+    pub trim: Option<TrimRegion>,
 }
 
 /// What one export file holds.
@@ -108,6 +111,27 @@ impl CurveDesc {
             weights: clamped.weights().map(<[f64]>::to_vec),
             closed: curve.is_closed(),
         })
+    }
+
+    /// The degree-1 B-spline through `points`, vertex k at parameter k; a closed one repeats
+    /// the first vertex at the end.
+    pub(crate) fn polyline(mut points: Vec<Point3>, closed: bool) -> CurveDesc {
+        if closed {
+            if let Some(&first) = points.first() {
+                points.push(first);
+            }
+        }
+        let m = points.len().saturating_sub(1);
+        let mut knots = vec![0.0];
+        knots.extend((0..=m).map(|k| k as f64));
+        knots.push(m as f64);
+        CurveDesc {
+            degree: 1,
+            knots,
+            control_points: points,
+            weights: None,
+            closed,
+        }
     }
 
     /// Checks counts, finiteness, weights and knot order.
@@ -153,6 +177,7 @@ impl SurfaceDesc {
             self.num_v + self.degree_v + 1,
         )?;
         check_points(what, &self.control_points, self.weights.as_deref(), n)?;
+        self.check_trim(what)?;
         if self.degree_u == 0
             || self.degree_v == 0
             || self.num_u <= self.degree_u
@@ -192,6 +217,77 @@ impl SurfaceDesc {
             }
         }
         Ok(num / den)
+    }
+
+    /// The parameter domain, `((u0, u1), (v0, v1))`.
+    pub fn domain(&self) -> ((f64, f64), (f64, f64)) {
+        (
+            (self.knots_u[self.degree_u], self.knots_u[self.num_u]),
+            (self.knots_v[self.degree_v], self.knots_v[self.num_v]),
+        )
+    }
+
+    /// A trim loop vertex outside the domain is an error (the writers would put the face's
+    /// boundary off the surface).
+    fn check_trim(&self, what: &str) -> Result<(), ExportError> {
+        let Some(trim) = &self.trim else {
+            return Ok(());
+        };
+        if self.knots_u.len() <= self.num_u || self.knots_v.len() <= self.num_v {
+            return Ok(());
+        }
+        let ((u0, u1), (v0, v1)) = self.domain();
+        for (k, l) in trim.loops().enumerate() {
+            if let Some(i) = l
+                .iter()
+                .position(|p| !(p[0] >= u0 && p[0] <= u1 && p[1] >= v0 && p[1] <= v1))
+            {
+                return Err(ExportError::Invalid {
+                    what: format!("{what} trim loop {k} vertex {i}"),
+                    reason: format!("({}, {}) is outside the domain", l[i][0], l[i][1]),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// A trim loop as the writers put it: its vertices in (u, v) (z = 0) and their surface
+    /// points, with vertices added along an edge wherever the chord between the surface points
+    /// strays from the surface by more than 1e-5 of the control grid's diagonal, so the 3D
+    /// polyline and the (u, v) polyline on the surface agree parameter by parameter.
+    pub(crate) fn trim_loop(
+        &self,
+        l: &[[f64; 2]],
+    ) -> Result<(Vec<Point3>, Vec<Point3>), ExportError> {
+        let (lo, hi) = self.control_points.iter().fold(
+            (
+                Point3::splat(f64::INFINITY),
+                Point3::splat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let tol = 1e-5 * (hi - lo).length();
+        let (mut uv, mut xyz) = (Vec::new(), Vec::new());
+        for k in 0..l.len() {
+            let (a, b) = (l[k], l[(k + 1) % l.len()]);
+            let mut stack = vec![(0.0, 1.0, self.eval(a[0], a[1])?, self.eval(b[0], b[1])?)];
+            // Depth-first, the first half first, so the vertices come out in order.
+            while let Some((t0, t1, p0, p1)) = stack.pop() {
+                let tm = (t0 + t1) / 2.0;
+                let at = |t: f64| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+                let m = at(tm);
+                let pm = self.eval(m[0], m[1])?;
+                if (pm - (p0 + p1) / 2.0).length() > tol && t1 - t0 > 1.0 / 64.0 {
+                    stack.push((tm, t1, pm, p1));
+                    stack.push((t0, tm, p0, pm));
+                } else {
+                    let s = at(t0);
+                    uv.push(Point3::new(s[0], s[1], 0.0));
+                    xyz.push(p0);
+                }
+            }
+        }
+        Ok((uv, xyz))
     }
 
     /// Control point (i, j).

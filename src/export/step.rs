@@ -3,6 +3,13 @@
 //! `GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION` attached to one product, in
 //! millimetres. Polynomial geometry uses `B_SPLINE_CURVE_WITH_KNOTS` /
 //! `B_SPLINE_SURFACE_WITH_KNOTS`; NURBS use the complex (rational) entity forms.
+//!
+//! A trimmed surface ([`SurfaceDesc::trim`]) becomes an `ADVANCED_FACE` on it, in an
+//! `OPEN_SHELL` of a `SHELL_BASED_SURFACE_MODEL` (a `MANIFOLD_SURFACE_SHAPE_REPRESENTATION`).
+//! Each trim loop is an `EDGE_LOOP` of four edges, each a `SURFACE_CURVE` whose 3D curve is the
+//! degree-1 B-spline through the surface points at the loop's vertices and whose `PCURVE` is
+//! that stretch of the loop as a degree-1 B-spline in (u, v), both parameterised alike (vertex
+//! k at k).
 
 use super::{real, CurveDesc, ExportError, ExportModel, SurfaceDesc};
 
@@ -68,11 +75,16 @@ fn logical(b: bool) -> &'static str {
 
 fn curve(d: &mut Data, c: &CurveDesc) -> usize {
     let pts: Vec<usize> = c.control_points.iter().map(|&p| d.point(p)).collect();
+    curve_on(d, c, &pts)
+}
+
+/// The curve entity of `c` over control point entities `pts`.
+fn curve_on(d: &mut Data, c: &CurveDesc, pts: &[usize]) -> usize {
     let (values, mults) = knot_runs(&c.knots);
     let common = format!(
         "{},{},.UNSPECIFIED.,{},.F.",
         c.degree,
-        refs(&pts),
+        refs(pts),
         logical(c.closed)
     );
     let knots = format!("{},{},.UNSPECIFIED.", ints(&mults), reals(&values));
@@ -123,6 +135,64 @@ fn surface(d: &mut Data, s: &SurfaceDesc) -> usize {
     }
 }
 
+/// Edges a trim loop is cut into: OCCT's area integration mishandles a loop that is one
+/// closed edge (the tessellation was right, `BRepGProp` was not).
+const EDGES_PER_LOOP: usize = 4;
+
+/// The face of trimmed surface `s` (entity `surf`), its loops' parameter curves in the 2D
+/// context `ctx2`.
+fn trimmed_face(
+    d: &mut Data,
+    s: &SurfaceDesc,
+    trim: &crate::spline::TrimRegion,
+    surf: usize,
+    ctx2: usize,
+) -> Result<usize, ExportError> {
+    let mut bounds = Vec::new();
+    for (k, l) in trim.loops().enumerate() {
+        let (flat, image) = s.trim_loop(l)?;
+        let n = flat.len();
+        let pieces = n.min(EDGES_PER_LOOP);
+        let cuts: Vec<usize> = (0..=pieces).map(|j| j * n / pieces).collect();
+        let vertices: Vec<usize> = cuts[..pieces]
+            .iter()
+            .map(|&c| {
+                let p = d.point(image[c]);
+                d.add(format!("VERTEX_POINT('',#{p})"))
+            })
+            .collect();
+        let mut edges = Vec::new();
+        for j in 0..pieces {
+            let range: Vec<usize> = (cuts[j]..=cuts[j + 1]).map(|i| i % n).collect();
+            let uv = CurveDesc::polyline(range.iter().map(|&i| flat[i]).collect(), false);
+            let pts2: Vec<usize> = uv
+                .control_points
+                .iter()
+                .map(|p| d.add(format!("CARTESIAN_POINT('',({},{}))", real(p.x), real(p.y))))
+                .collect();
+            let c2 = curve_on(d, &uv, &pts2);
+            let rep = d.add(format!("DEFINITIONAL_REPRESENTATION('',(#{c2}),#{ctx2})"));
+            let pcurve = d.add(format!("PCURVE('',#{surf},#{rep})"));
+            let c3 = curve(
+                d,
+                &CurveDesc::polyline(range.iter().map(|&i| image[i]).collect(), false),
+            );
+            let sc = d.add(format!("SURFACE_CURVE('',#{c3},(#{pcurve}),.PCURVE_S1.)"));
+            let (v0, v1) = (vertices[j], vertices[(j + 1) % pieces]);
+            let e = d.add(format!("EDGE_CURVE('',#{v0},#{v1},#{sc},.T.)"));
+            edges.push(d.add(format!("ORIENTED_EDGE('',*,*,#{e},.T.)")));
+        }
+        let el = d.add(format!("EDGE_LOOP('',{})", refs(&edges)));
+        let kind = if k == 0 {
+            "FACE_OUTER_BOUND"
+        } else {
+            "FACE_BOUND"
+        };
+        bounds.push(d.add(format!("{kind}('',#{el},.T.)")));
+    }
+    Ok(d.add(format!("ADVANCED_FACE('',{},#{surf},.T.)", refs(&bounds))))
+}
+
 /// The STEP text of `model`; `name` goes into the header and the product.
 pub fn write_step(model: &ExportModel, name: &str) -> Result<String, ExportError> {
     model.validate()?;
@@ -154,12 +224,39 @@ pub fn write_step(model: &ExportModel, name: &str) -> Result<String, ExportError
          GLOBAL_UNIT_ASSIGNED_CONTEXT((#{len},#{ang},#{sol}))REPRESENTATION_CONTEXT('',''))"
     ));
     let mut items: Vec<usize> = model.curves.iter().map(|c| curve(&mut d, c)).collect();
-    items.extend(model.surfaces.iter().map(|s| surface(&mut d, s)));
-    let set = d.add(format!("GEOMETRIC_SET('',{})", refs(&items)));
-    let rep = d.add(format!(
-        "GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION('{name}',(#{set}),#{ctx})"
-    ));
-    d.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    let mut faces = Vec::new();
+    let mut ctx2 = None;
+    for s in &model.surfaces {
+        let surf = surface(&mut d, s);
+        match &s.trim {
+            None => items.push(surf),
+            Some(trim) => {
+                let c2 = *ctx2.get_or_insert_with(|| {
+                    d.add(
+                        "(GEOMETRIC_REPRESENTATION_CONTEXT(2)PARAMETRIC_REPRESENTATION_CONTEXT()\
+                         REPRESENTATION_CONTEXT('2D SPACE',''))"
+                            .into(),
+                    )
+                });
+                faces.push(trimmed_face(&mut d, s, trim, surf, c2)?);
+            }
+        }
+    }
+    if !faces.is_empty() {
+        let shell = d.add(format!("OPEN_SHELL('',{})", refs(&faces)));
+        let model = d.add(format!("SHELL_BASED_SURFACE_MODEL('',(#{shell}))"));
+        let rep = d.add(format!(
+            "MANIFOLD_SURFACE_SHAPE_REPRESENTATION('{name}',(#{model}),#{ctx})"
+        ));
+        d.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    }
+    if !items.is_empty() || faces.is_empty() {
+        let set = d.add(format!("GEOMETRIC_SET('',{})", refs(&items)));
+        let rep = d.add(format!(
+            "GEOMETRICALLY_BOUNDED_SURFACE_SHAPE_REPRESENTATION('{name}',(#{set}),#{ctx})"
+        ));
+        d.add(format!("SHAPE_DEFINITION_REPRESENTATION(#{pds},#{rep})"));
+    }
     let mut out = String::from("ISO-10303-21;\nHEADER;\n");
     out.push_str("FILE_DESCRIPTION(('geofit B-spline export'),'2;1');\n");
     out.push_str(&format!(

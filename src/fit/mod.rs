@@ -51,7 +51,7 @@ pub use subdiv::{
 pub use surface::{
     energies, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
     GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, Parameterization,
-    SurfaceGrid, TolMode,
+    SurfaceGrid, SurfaceTrim, TolMode,
 };
 
 use crate::geom::Point3;

@@ -93,6 +93,7 @@ fn surfaces() -> Vec<(&'static str, SurfaceDesc)> {
         num_v: 6,
         control_points: grid(5, 6),
         weights: None,
+        trim: None,
     };
     let nurbs = SurfaceDesc {
         degree_u: 2,
@@ -103,6 +104,7 @@ fn surfaces() -> Vec<(&'static str, SurfaceDesc)> {
         num_v: 4,
         control_points: grid(4, 4),
         weights: Some((0..16).map(|k| 0.5 + 0.1 * (k % 5) as f64).collect()),
+        trim: None,
     };
     vec![("bspline_surface", bspline), ("nurbs_surface", nurbs)]
 }

@@ -64,7 +64,12 @@ macro_rules! surface_fitter_methods {
         }
 
         fn details(&self) -> serde_json::Map<String, serde_json::Value> {
-            super::details(&self.fit.surface, self.fit.num_folded)
+            super::details(
+                &self.fit.surface,
+                &self.fit.uv,
+                self.fit.state.data(),
+                self.fit.num_folded,
+            )
         }
     };
 }
@@ -74,6 +79,7 @@ mod least_squares;
 mod normal_system;
 mod parameterize;
 mod patches;
+mod trim;
 
 pub use geometric::{GeometricSurfaceFitter, GeometricSurfaceOptions};
 pub use least_squares::{energies, LsqSurfaceFitter, LsqSurfaceOptions};
@@ -81,11 +87,12 @@ pub use parameterize::{
     parameterize, parameterize_on_surface, FoldPolicy, ParamOptions, Parameterization,
 };
 pub use patches::TolMode;
+pub use trim::SurfaceTrim;
 
 use super::{FitError, FitState, Method, Scheme, Shape, Tolerances};
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
-use crate::spline::{BSplineSurface, KnotVector, SplineError, MAX_DEGREE};
+use crate::spline::{BSplineSurface, KnotVector, SplineError, TrimOptions, MAX_DEGREE};
 use patches::{correct_parameters, patch_errors, Criterion, PatchError, PatchGrid};
 use web_time::Instant;
 
@@ -357,8 +364,11 @@ pub(crate) fn iso_lines(s: &BSplineSurface, resolution: usize) -> Vec<Point3> {
 }
 
 /// What both surface fitters report besides the common figures.
+/// The trim is that of the export: its loops, vertices and areas, or why there is none.
 pub(crate) fn details(
     s: &BSplineSurface,
+    uv: &[[f64; 2]],
+    data: &[Point3],
     folded: usize,
 ) -> serde_json::Map<String, serde_json::Value> {
     let (nu, nv) = s.num_control();
@@ -366,6 +376,11 @@ pub(crate) fn details(
     m.insert("control_points_u".into(), nu.into());
     m.insert("control_points_v".into(), nv.into());
     m.insert("folded_points".into(), folded.into());
+    let trim = match SurfaceTrim::of(s, uv, data, &TrimOptions::default()) {
+        Ok(t) => t.details(),
+        Err(e) => serde_json::json!({ "untrimmed": e.to_string() }),
+    };
+    m.insert("trim".into(), trim);
     m
 }
 
