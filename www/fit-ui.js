@@ -93,7 +93,7 @@ class FitPanel {
       refine: /** @type {HTMLInputElement} */ (el('fit-refine')), maxControl: /** @type {HTMLInputElement} */ (el('fit-max-control')),
       play: el('fit-play'), step: el('fit-step'), reset: el('fit-reset'),
       vectors: /** @type {HTMLInputElement} */ (el('show-vectors')), cage: /** @type {HTMLInputElement} */ (el('show-cage')),
-      iso: /** @type {HTMLInputElement} */ (el('show-iso')), initialMesh: /** @type {HTMLInputElement} */ (el('show-initial')),
+      iso: /** @type {HTMLInputElement} */ (el('show-iso')), untrimmed: /** @type {HTMLInputElement} */ (el('show-untrimmed')), initialMesh: /** @type {HTMLInputElement} */ (el('show-initial')),
       chart: /** @type {HTMLCanvasElement} */ (el('fit-chart')),
       status: el('fit-status'), iter: el('fit-iter'), ctrl: el('fit-ctrl'), eAvg: el('fit-eavg'),
       eMax: el('fit-emax'), eRms: el('fit-erms'), eBack: el('fit-eback'), ms: el('fit-ms'), total: el('fit-total'),
@@ -123,7 +123,7 @@ class FitPanel {
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
     // deviation: the latest frame's distribution of the errors (protocol.js `Deviation`).
-    this.figures = { lastStats: null, history: [], deviation: null, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
+    this.figures = { lastStats: null, history: [], deviation: null, surfaceTriangles: 0, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
     this.tolUnits = [
       linkTolerance(this.ui.tolAvg, this.ui.tolAvgUnits, () => this.diagonal(), () => this.form.edited.add('tolAvg')),
       linkTolerance(this.ui.tolMax, this.ui.tolMaxUnits, () => this.diagonal(), () => this.form.edited.add('tolMax')),
@@ -218,8 +218,11 @@ class FitPanel {
   }
 
   drawSurface(viewer) {
-    const { limit } = this.frame;
-    if (limit.indices.length > 0) viewer.setMesh(limit.positions, limit.normals, limit.indices);
+    const { limit, untrimmed } = this.frame;
+    const whole = untrimmed && this.ui.untrimmed.checked;
+    this.figures.surfaceTriangles = (whole ? untrimmed.indices.length : limit.indices.length) / 3;
+    if (whole) viewer.setMesh(limit.positions, untrimmed.normals, untrimmed.indices);
+    else if (limit.indices.length > 0) viewer.setMesh(limit.positions, limit.normals, limit.indices);
     else viewer.setMesh(new Float32Array(), new Float32Array(), new Uint32Array());
   }
 
@@ -410,7 +413,7 @@ class FitPanel {
       input.addEventListener('change', () => this.built && this.restart());
     }
     u.refine.addEventListener('change', () => { u.maxControl.disabled = !u.refine.checked; });
-    for (const box of [u.cage, u.vectors, u.iso, u.initialMesh]) box.addEventListener('change', () => this.redraw());
+    for (const box of [u.cage, u.vectors, u.iso, u.untrimmed, u.initialMesh]) box.addEventListener('change', () => this.redraw());
     for (const button of document.querySelectorAll('[data-export]')) {
       const what = /** @type {HTMLElement} */ (button).dataset.export;
       button.addEventListener('click', () => this.worker.postMessage({ type: MSG.export, what }));

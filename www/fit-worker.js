@@ -45,6 +45,14 @@ function postFrame(f, kind) {
     resolution -= 1;
     limit = f.limitMesh(resolution);
   }
+  // A B-spline surface is drawn cut to the data's outline; the whole surface (same points)
+  // comes along for the page's "untrimmed" toggle.
+  let untrimmed = null;
+  if (f.stats().scheme === 'bspline-surface') {
+    const whole = f.limitMesh(resolution, true);
+    untrimmed = { normals: whole.normals, indices: whole.indices };
+    whole.free();
+  }
   const control = f.controlMesh();
   /** @type {import('./protocol.js').FrameMessage} */
   const frame = {
@@ -57,6 +65,7 @@ function postFrame(f, kind) {
     errors: f.pointErrors(),
     deviation: f.deviations(HISTOGRAM_BINS),
     limit: { positions: limit.positions, normals: limit.normals, indices: limit.indices, edges: limit.edges },
+    untrimmed,
     control: { positions: control.positions, edges: control.edges },
     vectors: f.errorVectors(),
     iso: f.isoLines(resolution),

@@ -26,11 +26,13 @@
  *   type: 'frame', kind: 'start' | 'play' | 'pause' | 'step', generation: number, playing: boolean,
  *   stats: import('../pkg/geofit.js').FitStats, history: import('../pkg/geofit.js').HistoryEntry[], errors: Float32Array,
  *   deviation: import('../pkg/geofit.js').Deviation,
- *   limit: Shape, control: { positions: Float32Array, edges: Uint32Array },
+ *   limit: Shape, untrimmed: { normals: Float32Array, indices: Uint32Array } | null,
+ *   control: { positions: Float32Array, edges: Uint32Array },
  *   vectors: Float32Array, iso: Float32Array,
  *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array }, notes: string[] },
  * }} FrameMessage
- *   The state of the fit after a slice; `once` (data points, initial control net and what was
+ *   The state of the fit after a slice (`limit` a B-spline surface cut to the data's outline,
+ *   `untrimmed` its whole tessellation over the same positions); `once` (data points, initial control net and what was
  *   done to the data on intake) only on the first frame of a fit.
  * @typedef {{ type: 'exported', what: string, bytes: Uint8Array, quality?: import('../pkg/geofit.js').FemQuality }} ExportedMessage
  *   An export's bytes; `quality` for the FEM mesh (`msh`).
@@ -61,6 +63,7 @@ export function frameTransfers(frame) {
     frame.errors, frame.limit.positions, frame.limit.normals, frame.limit.indices, frame.limit.edges,
     frame.control.positions, frame.control.edges, frame.vectors, frame.iso,
   ];
+  if (frame.untrimmed) arrays.push(frame.untrimmed.normals, frame.untrimmed.indices);
   if (frame.once) arrays.push(frame.once.data, frame.once.initial.positions, frame.once.initial.edges);
   return arrays.map((a) => /** @type {ArrayBuffer} */ (a.buffer));
 }

@@ -206,6 +206,15 @@ pub trait Fitter {
     /// `resolution` is clamped to 1..=64.
     fn limit_shape(&self, resolution: usize) -> Shape;
 
+    /// The fitted surface cut to the face the CAD exports write: a B-spline surface's
+    /// tessellation (as [`Fitter::limit_shape`], on the same points) without the quads beyond
+    /// the outline of the data's parameters; `None` for other shapes, or when no outline can be
+    /// built (the exports then write the whole surface).
+    fn trimmed_limit_shape(&self, resolution: usize) -> Option<Shape> {
+        let _ = resolution;
+        None
+    }
+
     /// Iso-parameter lines at the knots of a B-spline surface as segment end points (two per
     /// segment, `resolution` segments per knot span); none for other shapes.
     fn iso_lines(&self, resolution: usize) -> Vec<Point3> {

@@ -411,10 +411,16 @@ impl Fitter {
     }
 
     /// The fitted shape: the surface tessellated with `resolution` segments per patch edge
-    /// (1..=64), or the curve as a polyline (`edges` only).
+    /// (1..=64), or the curve as a polyline (`edges` only). A B-spline surface is cut to the
+    /// outline of the data, the face the STEP and IGES exports write, unless `untrimmed` is
+    /// `true` (both on the same points, so their `positions` agree).
     #[wasm_bindgen(js_name = limitMesh)]
-    pub fn limit_mesh(&self, resolution: usize) -> MeshArrays {
-        MeshArrays::of(&self.fit.limit_shape(resolution))
+    pub fn limit_mesh(&self, resolution: usize, untrimmed: Option<bool>) -> MeshArrays {
+        let trimmed = match untrimmed {
+            Some(true) => None,
+            _ => self.fit.trimmed_limit_shape(resolution),
+        };
+        MeshArrays::of(&trimmed.unwrap_or_else(|| self.fit.limit_shape(resolution)))
     }
 
     /// Iso-parameter lines of a B-spline surface at its knots, as line segments (`x, y, z` of

@@ -346,6 +346,14 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     const zebra = await viewPixels(page, `fit-bspline-zebra-${backend.name}.png`);
     await page.uncheck('#show-zebra');
     await page.check('#show-points');
+    // Drawn cut to the data's outline; the toggle shows the whole rectangle of the surface.
+    const trimmed = await page.evaluate(() => window.geofitFit.surfaceTriangles);
+    await page.check('#show-untrimmed');
+    await page.waitForTimeout(300);
+    const whole = await page.evaluate(() => window.geofitFit.surfaceTriangles);
+    await page.uncheck('#show-untrimmed');
+    console.log(`[e2e] ${backend.name} bspline-surface: ${trimmed} triangles trimmed, ${whole} untrimmed`);
+    assert.ok(trimmed > 0 && trimmed < 0.95 * whole, `trimmed ${trimmed} of ${whole} triangles`);
     assert.ok(iso.cyan > 200, `iso-parameter lines drawn: ${JSON.stringify(iso)}`);
     assert.ok(zebra.black > 1000 && zebra.white > 1000, `zebra stripes drawn: ${JSON.stringify(zebra)}`);
     const tag = `${backend.name}-bspline`;

@@ -52,6 +52,10 @@ macro_rules! surface_fitter_methods {
             super::surface_mesh(&self.fit.surface, resolution)
         }
 
+        fn trimmed_limit_shape(&self, resolution: usize) -> Option<Shape> {
+            super::trimmed_surface_mesh(&self.fit.surface, &self.fit.uv, resolution)
+        }
+
         fn iso_lines(&self, resolution: usize) -> Vec<Point3> {
             super::iso_lines(&self.fit.surface, resolution)
         }
@@ -339,13 +343,41 @@ pub(crate) fn control_grid(s: &BSplineSurface) -> Shape {
 
 /// The surface sampled `resolution` times per knot span in each direction, as a quad mesh.
 pub(crate) fn surface_mesh(s: &BSplineSurface, resolution: usize) -> Shape {
+    grid_shape(s, resolution, |_, _| true)
+}
+
+/// The tessellation of [`surface_mesh`] without the quads whose centre lies outside the trim of
+/// the data's parameters `uv` (the face the STEP and IGES exports write), on the same grid of
+/// points; `None` when no trim can be built (the exports then write the whole surface too). The
+/// edge follows the grid, so it is as fine as `resolution`.
+pub(crate) fn trimmed_surface_mesh(
+    s: &BSplineSurface,
+    uv: &[[f64; 2]],
+    resolution: usize,
+) -> Option<Shape> {
+    let region = trim::outline_on(s, uv, &TrimOptions::default()).ok()?.region;
+    Some(grid_shape(s, resolution, |u, v| region.contains(u, v)))
+}
+
+/// The surface sampled on its knot grid (`resolution` segments per span), with the quads whose
+/// parameter centre `keep` accepts.
+fn grid_shape(s: &BSplineSurface, resolution: usize, keep: impl Fn(f64, f64) -> bool) -> Shape {
     let r = resolution.clamp(1, 64);
     let (us, vs) = (span_samples(s.knots_u(), r), span_samples(s.knots_v(), r));
     let points = us
         .iter()
         .flat_map(|&u| vs.iter().map(move |&v| s.eval(u, v)))
         .collect();
-    Shape::Mesh(grid_mesh(points, us.len(), vs.len()))
+    let (nv, mut quads) = (vs.len(), Vec::new());
+    let at = |i: usize, j: usize| (i * nv + j) as u32;
+    for i in 1..us.len() {
+        for j in 1..nv {
+            if keep(0.5 * (us[i - 1] + us[i]), 0.5 * (vs[j - 1] + vs[j])) {
+                quads.push([at(i - 1, j - 1), at(i, j - 1), at(i, j), at(i - 1, j)]);
+            }
+        }
+    }
+    Shape::Mesh(PolyMesh::try_new(points, quads).unwrap_or_default())
 }
 
 /// Iso-parameter lines at the knots, as segment end points (`resolution` segments per span).

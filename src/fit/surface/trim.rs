@@ -2,7 +2,7 @@
 //! ([`TrimRegion::outline`]), with the two areas that say how well it covers the data.
 
 use crate::geom::Point3;
-use crate::spline::{BSplineSurface, TrimError, TrimOptions, TrimRegion};
+use crate::spline::{BSplineSurface, Outline, TrimError, TrimOptions, TrimRegion};
 
 /// Cells per side of the (u, v) grid the trimmed area is integrated on.
 const AREA_GRID: usize = 256;
@@ -21,6 +21,21 @@ pub struct SurfaceTrim {
     pub dropped_loops: usize,
 }
 
+/// The outline of the parameters `uv` (clamped into `surface`'s domain first, so the loops lie
+/// on the surface): what the exports trim to and the page draws.
+pub(crate) fn outline_on(
+    surface: &BSplineSurface,
+    uv: &[[f64; 2]],
+    options: &TrimOptions,
+) -> Result<Outline, TrimError> {
+    let ((u0, u1), (v0, v1)) = surface.domain();
+    let clamped: Vec<[f64; 2]> = uv
+        .iter()
+        .map(|p| [p[0].clamp(u0, u1), p[1].clamp(v0, v1)])
+        .collect();
+    TrimRegion::outline(&clamped, options)
+}
+
 impl SurfaceTrim {
     /// The trim of `surface` fitted to `data` with foot-point parameters `uv` (clamped into
     /// the domain first, so the loops lie on the surface).
@@ -30,12 +45,7 @@ impl SurfaceTrim {
         data: &[Point3],
         options: &TrimOptions,
     ) -> Result<SurfaceTrim, TrimError> {
-        let ((u0, u1), (v0, v1)) = surface.domain();
-        let clamped: Vec<[f64; 2]> = uv
-            .iter()
-            .map(|p| [p[0].clamp(u0, u1), p[1].clamp(v0, v1)])
-            .collect();
-        let outline = TrimRegion::outline(&clamped, options)?;
+        let outline = outline_on(surface, uv, options)?;
         let data_area = outline
             .triangles
             .iter()
