@@ -1,6 +1,7 @@
 //! Fitting one tensor-product B-spline surface to a scan: by error vectors
 //! ([`GeometricSurfaceFitter`], SPEC §1 applied to B-splines) or by smoothed least squares
-//! ([`LsqSurfaceFitter`], SPEC §2). Both share the grid they start from and split
+//! ([`LsqSurfaceFitter`], SPEC §2), or as a family of section curves ([`SectionsFitter`],
+//! skinning, SPEC §3 on gridded data). The first two share the grid they start from and split
 //! ([`SurfaceGrid`]), the parameterisation, the per-patch tolerance test and the drawable
 //! shapes here.
 
@@ -74,6 +75,7 @@ mod least_squares;
 mod normal_system;
 mod parameterize;
 mod patches;
+mod sections;
 
 pub use geometric::{GeometricSurfaceFitter, GeometricSurfaceOptions};
 pub use least_squares::{energies, LsqSurfaceFitter, LsqSurfaceOptions};
@@ -81,6 +83,7 @@ pub use parameterize::{
     parameterize, parameterize_on_surface, FoldPolicy, ParamOptions, Parameterization,
 };
 pub use patches::TolMode;
+pub use sections::{detect_rows, grid_rows, SectionsFitter, SectionsOptions};
 
 use super::{FitError, FitState, Method, Scheme, Shape, Tolerances};
 use crate::geom::Point3;
