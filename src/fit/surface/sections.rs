@@ -150,7 +150,8 @@ impl SectionsFitter {
         let tol = options.tol_pct / 100.0 * diagonal;
         let fitters = row_fitters(points, &rows, &options, tol)?;
         let row_params: Vec<f64> = fitters.iter().flat_map(|f| f.params().to_vec()).collect();
-        let row_curves: Vec<BSplineCurve> = fitters.iter().map(|f| f.curve().clone()).collect();
+        let curves: Vec<BSplineCurve> = fitters.iter().map(|f| f.curve().clone()).collect();
+        let row_curves = on_common_knots(&curves, points, &rows, &row_params, options.degree)?;
         let (surface, v) = skin(&row_curves, &options, f64::INFINITY)?;
         let uv = initial_uv(&rows, &row_params, &v);
         let state = FitState::new(
@@ -213,11 +214,6 @@ impl SectionsFitter {
         self.state.errors_changed();
     }
 
-    /// The data of row `r`.
-    fn row(&self, r: usize) -> &[Point3] {
-        &self.state.data()[self.rows[r].clone()]
-    }
-
     /// Stage 1: every row fitted to the tolerance.
     fn fit_rows(&mut self) -> Result<(), FitError> {
         let tol = self.options.tol_pct / 100.0 * self.state.diagonal();
@@ -231,14 +227,13 @@ impl SectionsFitter {
 
     /// Stage 2: the row curves re-fitted on their merged knots.
     fn common_knots(&mut self) -> Result<(), FitError> {
-        let per_row = self.rows.iter().map(|r| r.len()).max().unwrap_or(1);
-        let knots = merged_knots(&self.row_curves, 0.5 / per_row as f64);
-        let mut curves = Vec::with_capacity(self.rows.len());
-        for (r, range) in self.rows.iter().enumerate() {
-            let params = &self.row_params[range.clone()];
-            curves.push(refit(&knots, self.options.degree, self.row(r), params)?);
-        }
-        self.row_curves = curves;
+        self.row_curves = on_common_knots(
+            &self.row_curves,
+            self.state.data(),
+            &self.rows,
+            &self.row_params,
+            self.options.degree,
+        )?;
         Ok(())
     }
 
@@ -279,6 +274,23 @@ fn check_rows(rows: &[std::ops::Range<usize>], degree: usize) -> Result<(), FitE
         });
     }
     Ok(())
+}
+
+/// The row `curves` re-fitted to the data `points` of their `rows` (at `params`, in data
+/// order) on their merged knots: knots of different rows closer than half a data spacing
+/// become one.
+fn on_common_knots(
+    curves: &[BSplineCurve],
+    points: &[Point3],
+    rows: &[std::ops::Range<usize>],
+    params: &[f64],
+    degree: usize,
+) -> Result<Vec<BSplineCurve>, FitError> {
+    let per_row = rows.iter().map(|r| r.len()).max().unwrap_or(1);
+    let knots = merged_knots(curves, 0.5 / per_row as f64);
+    rows.iter()
+        .map(|r| refit(&knots, degree, &points[r.clone()], &params[r.clone()]))
+        .collect()
 }
 
 /// A knot-placement fitter per row (multiple knots placed, first solve done), to an E_max of
