@@ -8,6 +8,10 @@ use geofit::fit::{
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::PolyMesh;
 
+#[path = "../examples/sections_bottle/bottle.rs"]
+mod bottle;
+use bottle::bottle;
+
 /// A roof: z = 0.4·|x − c(y)| over [0, 1]², the crease x = c(y) = 0.45 + 0.1·y crossing every
 /// row; 41 rows of 41 points, rows along x. Normals of the two planes differ by
 /// 2·atan(0.4) ≈ 43.6°.
@@ -17,33 +21,6 @@ fn roof(n: usize) -> Vec<Point3> {
             (0..n).map(move |c| {
                 let (x, y) = (c as f64 / (n - 1) as f64, r as f64 / (n - 1) as f64);
                 Point3::new(x, y, 0.4 * (x - 0.45 - 0.1 * y).abs())
-            })
-        })
-        .collect()
-}
-
-/// The bottle: the front 160° of a surface of revolution, profiles (rows, along z, 2 mm pitch)
-/// at 51 angles; radius 36 mm up to the shoulder crease at z = 60, then 12 + 24·(1 − t)² to
-/// the neck (t = (z − 60)/30: a tangent jump of 58° at the shoulder, a curvature jump at the
-/// neck), then the neck, radius 12, to z = 100.
-fn bottle() -> Vec<Point3> {
-    let radius = |z: f64| {
-        if z <= 60.0 {
-            36.0
-        } else if z <= 90.0 {
-            let t = (z - 60.0) / 30.0;
-            12.0 + 24.0 * (1.0 - t).powi(2)
-        } else {
-            12.0
-        }
-    };
-    (0..51)
-        .flat_map(|r| {
-            let theta = (-80.0 + 160.0 * r as f64 / 50.0_f64).to_radians();
-            (0..51).map(move |k| {
-                let z = 2.0 * k as f64;
-                let rad = radius(z);
-                Point3::new(rad * theta.sin(), rad * theta.cos(), z)
             })
         })
         .collect()
@@ -62,8 +39,7 @@ fn normal(f: &SectionsFitter, u: f64, v: f64) -> Vec3 {
 #[test]
 fn roof_crease_stays_sharp_and_tolerance_is_met() {
     let pts = roof(41);
-    let mut fit =
-        SectionsFitter::try_new(&pts, rows_of(41, 41), SectionsOptions::DEFAULT).unwrap();
+    let mut fit = SectionsFitter::try_new(&pts, rows_of(41, 41), SectionsOptions::DEFAULT).unwrap();
     let status = fit.run().unwrap();
     assert_eq!(status, FitStatus::Converged, "{:?}", fit.stats());
     assert!(fit.stats().e_max_pct <= 0.1);
@@ -90,7 +66,12 @@ fn bottle_meets_threshold_and_keeps_the_shoulder() {
     assert_eq!(fit.run().unwrap(), FitStatus::Converged);
     let e_max = fit.stats().e_max_pct / 100.0 * diag;
     assert!(e_max <= 0.1 + 1e-9, "E_max {e_max} mm");
-    assert!(fit.sigma() < first, "σ {} after {} first", fit.sigma(), first);
+    assert!(
+        fit.sigma() < first,
+        "σ {} after {} first",
+        fit.sigma(),
+        first
+    );
     // Shoulder crease at z = 60 (u = chord parameter there): the profile turns by 58°.
     let data_angle = (48.0f64 / 30.0).atan();
     let row = &pts[25 * 51..26 * 51];
@@ -138,24 +119,42 @@ fn bad_inputs_are_typed_errors() {
     let o = SectionsOptions::DEFAULT;
     let pts = roof(21);
     let few = SectionsFitter::try_new(&pts[..21 * 5], rows_of(5, 21), o).err();
-    assert!(matches!(few, Some(FitError::TooFewRows { found: 5, .. })), "{few:?}");
+    assert!(
+        matches!(few, Some(FitError::TooFewRows { found: 5, .. })),
+        "{few:?}"
+    );
     let mut ragged = rows_of(21, 21);
     ragged[3] = 63..83;
     ragged[4] = 83..105;
     let err = SectionsFitter::try_new(&pts, ragged, o).err();
-    assert!(matches!(err, Some(FitError::RaggedRows { row: 3, .. })), "{err:?}");
+    assert!(
+        matches!(err, Some(FitError::RaggedRows { row: 3, .. })),
+        "{err:?}"
+    );
     let mut nan = pts.clone();
     nan[30].y = f64::NAN;
     let err = SectionsFitter::try_new(&nan, rows_of(21, 21), o).err();
-    assert!(matches!(err, Some(FitError::NonFinitePoint { .. })), "{err:?}");
+    assert!(
+        matches!(err, Some(FitError::NonFinitePoint { .. })),
+        "{err:?}"
+    );
     let one: Vec<Point3> = (0..20).map(|i| Point3::new(0.0, i as f64, 0.0)).collect();
     let err = SectionsFitter::try_new(&one, rows_of(20, 1), o).err();
-    assert!(matches!(err, Some(FitError::TooFewPoints { found: 1, .. })), "{err:?}");
+    assert!(
+        matches!(err, Some(FitError::TooFewPoints { found: 1, .. })),
+        "{err:?}"
+    );
     let bad = o.with_tol_pct(-1.0);
     assert!(SectionsFitter::try_new(&pts, rows_of(21, 21), bad).is_err());
     let spec = FitSpec::new(Scheme::BsplineSurface)
         .with_method(Some(Method::Sections))
         .with_initial(Some(64));
-    assert!(matches!(spec.validate(), Err(FitError::NotApplicable { name: "initial", .. })));
+    assert!(matches!(
+        spec.validate(),
+        Err(FitError::NotApplicable {
+            name: "initial",
+            ..
+        })
+    ));
     assert!(Scheme::BsplineSurface.methods().contains(&Method::Sections));
 }

@@ -47,9 +47,9 @@ pub use subdiv::{
     SubdivFitOptions, SubdivFitter, Weighting,
 };
 pub use surface::{
-    detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
-    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, Parameterization,
-    SectionsFitter, SectionsOptions, SurfaceGrid, TolMode,
+    detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, FoldPolicy,
+    GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions,
+    ParamOptions, Parameterization, SectionsFitter, SectionsOptions, SurfaceGrid, TolMode,
 };
 
 use crate::geom::Point3;

@@ -298,9 +298,7 @@ impl OptionInfo {
     }
 }
 
-use Method::{
-    Geometric as GEO, KnotPlacement as KNOTS, LeastSquares as LSQ, Sections as SECTIONS,
-};
+use Method::{Geometric as GEO, KnotPlacement as KNOTS, LeastSquares as LSQ, Sections as SECTIONS};
 use Scheme::{
     BsplineCurve as BC, BsplineSurface as BS, CatmullClark as CC, ChaikinCurve as CH,
     DooSabin as DS, Loop as LP,

@@ -204,13 +204,7 @@ impl SectionsFitter {
     /// Foot points from the current parameters, the errors and their statistics.
     fn measure(&mut self) {
         let (points, errors) = self.state.data_and_errors_mut();
-        correct_parameters(
-            &self.surface,
-            points,
-            &mut self.uv,
-            errors,
-            FOOT_ITERATIONS,
-        );
+        correct_parameters(&self.surface, points, &mut self.uv, errors, FOOT_ITERATIONS);
         self.state.errors_changed();
     }
 
@@ -405,7 +399,10 @@ fn merged_knots(curves: &[BSplineCurve], gap: f64) -> Vec<(f64, usize)> {
         let interior = &k[p + 1..k.len() - p - 1];
         let mut i = 0;
         while i < interior.len() {
-            let m = interior[i..].iter().take_while(|&&x| x == interior[i]).count();
+            let m = interior[i..]
+                .iter()
+                .take_while(|&&x| x == interior[i])
+                .count();
             all.push((interior[i], m));
             i += m;
         }
