@@ -158,3 +158,55 @@ fn bad_inputs_are_typed_errors() {
     ));
     assert!(Scheme::BsplineSurface.methods().contains(&Method::Sections));
 }
+
+#[test]
+fn cli_fits_an_xyz_in_rows_and_exports_step() {
+    let dir = std::env::temp_dir().join(format!("geofit-sections-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let xyz = dir.join("bottle.xyz");
+    let text: String = bottle()
+        .iter()
+        .map(|p| format!("{} {} {}\n", p.x, p.y, p.z))
+        .collect();
+    std::fs::write(&xyz, text).unwrap();
+    for rows in [None, Some("51")] {
+        let json = dir.join("r.json");
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"));
+        cmd.arg("fit").arg(&xyz).args([
+            "--scheme",
+            "bspline",
+            "--method",
+            "sections",
+            "--tol-max",
+            "0.08",
+            "--json",
+        ]);
+        cmd.arg(&json).arg("--step").arg(dir.join("b.stp"));
+        if let Some(n) = rows {
+            cmd.args(["--rows", n]);
+        }
+        let out = cmd.output().unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(r["converged"], true, "{r}");
+        assert_eq!(r["rows"], 51, "{r}");
+        assert!(std::fs::read_to_string(dir.join("b.stp"))
+            .unwrap()
+            .contains("B_SPLINE_SURFACE"));
+    }
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
+        .arg("fit")
+        .arg(&xyz)
+        .args([
+            "--scheme", "bspline", "--method", "sections", "--rows", "50",
+        ])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("row"));
+}
