@@ -460,7 +460,7 @@ pub fn detect_rows(points: &[Point3], per_row: Option<usize>) -> Vec<std::ops::R
             .collect();
     }
     if points.len() < 2 {
-        return vec![0..points.len()];
+        return std::iter::once(0..points.len()).collect();
     }
     let steps: Vec<_> = points.windows(2).map(|w| w[1] - w[0]).collect();
     let mut lengths: Vec<f64> = steps.iter().map(|s| s.length()).collect();
