@@ -11,6 +11,7 @@ const METHOD_LABELS = {
   geometric: 'error vectors (geometric)',
   'least-squares': 'least squares',
   knots: 'knot placement (least squares)',
+  sections: 'sections (skinning of gridded rows)',
 };
 
 /** The placeholder of a field whose default the data decides. */

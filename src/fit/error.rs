@@ -33,6 +33,25 @@ pub enum FitError {
         /// Points needed.
         needed: usize,
     },
+    /// Gridded data with fewer rows than a skinned surface needs.
+    #[error("too few rows: {found}, need at least {needed}")]
+    TooFewRows {
+        /// Rows found.
+        found: usize,
+        /// Rows needed.
+        needed: usize,
+    },
+    /// Gridded data whose rows differ in length: a skinned surface needs one point per
+    /// column in every row.
+    #[error("row {row} has {found} points, the first row {expected}")]
+    RaggedRows {
+        /// Index of the first row of another length.
+        row: usize,
+        /// Its points.
+        found: usize,
+        /// Points of the first row.
+        expected: usize,
+    },
     /// An option is out of its valid range.
     ///
     /// ```

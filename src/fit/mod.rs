@@ -8,7 +8,7 @@
 //! |---|---|
 //! | `spec` | [`FitSpec`]: what to fit and how, with every default and its validation |
 //! | `subdiv` | [`SubdivFitter`]: Loop, Catmull–Clark and Doo–Sabin limit surfaces (SPEC §1) |
-//! | `surface` | [`GeometricSurfaceFitter`], [`LsqSurfaceFitter`]: one B-spline surface (SPEC §1, §2) |
+//! | `surface` | [`GeometricSurfaceFitter`], [`LsqSurfaceFitter`], [`SectionsFitter`]: one B-spline surface (SPEC §1, §2, §3 skinning) |
 //! | `curve` | [`CurveFitter`], [`KnotPlacementFitter`]: B-spline curves (SPEC §1.9, §3) |
 //! | `state`, `log` | [`FitState`], [`FitLog`]: data, errors, history and status, kept alike by every engine |
 //! | `report` | [`FitReport`]: the machine-readable summary of any fit |
@@ -49,9 +49,10 @@ pub use subdiv::{
     SubdivFitOptions, SubdivFitter, Weighting,
 };
 pub use surface::{
-    energies, parameterize, parameterize_on_surface, FoldPolicy, GeometricSurfaceFitter,
-    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, Parameterization,
-    SurfaceGrid, SurfaceTrim, TolMode,
+    detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, FoldPolicy,
+    GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions,
+    ParamOptions, Parameterization, SectionsFitter, SectionsOptions, SurfaceGrid, SurfaceTrim,
+    TolMode,
 };
 
 use crate::geom::Point3;

@@ -28,8 +28,8 @@ use super::curve::{CurveFitOptions, CurveFitter, KnotPlacementFitter, KnotPlacem
 use super::strays::WithoutStrays;
 use super::subdiv::{build_subdiv_fitter, SubdivFitOptions, Weighting};
 use super::surface::{
-    FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter,
-    LsqSurfaceOptions, SurfaceGrid, TolMode,
+    detect_rows, grid_rows, FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions,
+    LsqSurfaceFitter, LsqSurfaceOptions, SectionsFitter, SectionsOptions, SurfaceGrid, TolMode,
 };
 use super::{Acceleration, FitError, Fitter, Tolerances};
 use crate::cloud::{ReconstructOptions, SurfaceKind};
@@ -87,7 +87,7 @@ impl Scheme {
     /// The methods the scheme can be fitted with; the first is its default.
     pub const fn methods(self) -> &'static [Method] {
         match self {
-            Scheme::BsplineSurface => &[Method::LeastSquares, Method::Geometric],
+            Scheme::BsplineSurface => &[Method::LeastSquares, Method::Geometric, Method::Sections],
             Scheme::BsplineCurve | Scheme::ChaikinCurve => {
                 &[Method::Geometric, Method::KnotPlacement]
             }
@@ -120,12 +120,15 @@ pub enum Method {
     LeastSquares,
     /// Least squares with knots placed at features and deviations (SPEC §3).
     KnotPlacement,
+    /// Skinning: gridded data's rows fitted by knot placement, then curves across them.
+    Sections,
 }
 
 named_enum!(Method, "method", {
     Geometric => "geometric",
     LeastSquares => "least-squares",
     KnotPlacement => "knots",
+    Sections => "sections",
 });
 
 /// How bare points (no faces) are meshed before a subdivision fit.
@@ -268,6 +271,9 @@ pub struct FitSpec {
     pub corner_angle: Option<f64>,
     /// Curves, knots method: second-derivative jump that makes a double knot (1 / diagonal).
     pub curvature_jump: Option<f64>,
+    /// B-spline surface, sections method: points per row of data without a range grid [rows
+    /// start at every jump].
+    pub rows: Option<usize>,
 }
 
 /// One field of [`FitSpec`]: its name (camelCase, as JavaScript and the errors spell it), its
@@ -292,7 +298,7 @@ impl OptionInfo {
     }
 }
 
-use Method::{Geometric as GEO, KnotPlacement as KNOTS, LeastSquares as LSQ};
+use Method::{Geometric as GEO, KnotPlacement as KNOTS, LeastSquares as LSQ, Sections as SECTIONS};
 use Scheme::{
     BsplineCurve as BC, BsplineSurface as BS, CatmullClark as CC, ChaikinCurve as CH,
     DooSabin as DS, Loop as LP,
@@ -349,11 +355,23 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
         "initial",
         "initial",
         &[LP, CC, DS, BS],
-        &[],
+        &[GEO, LSQ],
         "initial control points"
     ),
-    info!("grid", "ctrl-u", &[BS], &[], "control points along u and v"),
-    info!("maxIter", "max-iter", ALL, &[], "iteration cap"),
+    info!(
+        "grid",
+        "ctrl-u",
+        &[BS],
+        &[GEO, LSQ],
+        "control points along u and v"
+    ),
+    info!(
+        "maxIter",
+        "max-iter",
+        ALL,
+        &[GEO, LSQ, KNOTS],
+        "iteration cap"
+    ),
     info!(
         "refine",
         "no-refine",
@@ -414,7 +432,13 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
     ),
     info!("closed", "closed", CURVES, &[], "fit a closed curve"),
     info!("degree", "degree", &[BS, BC], &[], "degree"),
-    info!("tolMode", "tol-mode", &[BS], &[], "how patches are judged"),
+    info!(
+        "tolMode",
+        "tol-mode",
+        &[BS],
+        &[GEO, LSQ],
+        "how patches are judged"
+    ),
     info!("beta2", "beta2", &[BS], &[LSQ], "thin-plate weight β2"),
     info!(
         "beta3",
@@ -428,23 +452,36 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
         "view",
         "view",
         &[BS],
-        &[],
+        &[GEO, LSQ],
         "view direction of the projection"
     ),
-    info!("folded", "folded", &[BS], &[], "points on a fold-over"),
+    info!(
+        "folded",
+        "folded",
+        &[BS],
+        &[GEO, LSQ],
+        "points on a fold-over"
+    ),
     info!(
         "cornerAngle",
         "corner-angle",
-        CURVES,
-        &[KNOTS],
+        &[BS, BC, CH],
+        &[KNOTS, SECTIONS],
         "angle that makes a corner, degrees"
     ),
     info!(
         "curvatureJump",
         "curvature-jump",
-        CURVES,
-        &[KNOTS],
+        &[BS, BC, CH],
+        &[KNOTS, SECTIONS],
         "jump that makes a double knot"
+    ),
+    info!(
+        "rows",
+        "rows",
+        &[BS],
+        &[SECTIONS],
+        "points per row of gridded data"
     ),
 ];
 
@@ -459,7 +496,7 @@ macro_rules! spec_fields {
             cloud: "cloud", outliers: "outliers", use_grid: "useGrid", closed: "closed",
             degree: "degree", tol_mode: "tolMode", beta2: "beta2", beta3: "beta3",
             solves: "solves", view: "view", folded: "folded", corner_angle: "cornerAngle",
-            curvature_jump: "curvatureJump")
+            curvature_jump: "curvatureJump", rows: "rows")
     };
 }
 
@@ -496,6 +533,7 @@ impl FitSpec {
         folded: FoldPolicy::Keep,
         corner_angle: None,
         curvature_jump: None,
+        rows: None,
     };
 
     /// A fit of `scheme` with every other field at its default.
@@ -564,6 +602,9 @@ impl FitSpec {
                 d.degree = Some(g.degree);
                 (d.beta2, d.beta3, d.solves) =
                     (Some(l.beta2), Some(l.beta3), Some(l.solves_per_knots));
+                let s = SectionsOptions::DEFAULT;
+                (d.corner_angle, d.curvature_jump) =
+                    (Some(s.corner_angle_deg), Some(s.curvature_jump));
             }
             Scheme::BsplineCurve | Scheme::ChaikinCurve => {
                 let k = KnotPlacementOptions::DEFAULT;
@@ -666,6 +707,7 @@ impl FitSpec {
             }
             Scheme::BsplineSurface => match self.method() {
                 Method::LeastSquares => self.lsq_options().validate(),
+                Method::Sections => self.sections_options().validate(),
                 _ => self.geometric_surface_options().validate(),
             },
             Scheme::BsplineCurve | Scheme::ChaikinCurve => match self.method() {
@@ -703,6 +745,21 @@ impl FitSpec {
             (Scheme::BsplineSurface, Method::Geometric) => Box::new(
                 GeometricSurfaceFitter::try_new(points, self.geometric_surface_options())?,
             ),
+            (Scheme::BsplineSurface, Method::Sections) => {
+                let (points, rows) = match data.grid {
+                    Some(grid) => {
+                        let (indices, rows) = grid_rows(grid);
+                        let pick = indices.iter().filter_map(|&i| points.get(i as usize));
+                        (pick.copied().collect(), rows)
+                    }
+                    None => (points.to_vec(), detect_rows(points, self.rows)),
+                };
+                Box::new(SectionsFitter::try_new(
+                    &points,
+                    rows,
+                    self.sections_options(),
+                )?)
+            }
             (Scheme::BsplineSurface, _) => {
                 Box::new(LsqSurfaceFitter::try_new(points, self.lsq_options())?)
             }
@@ -741,6 +798,7 @@ impl FitSpec {
     /// cap is the number of points).
     fn default_max_iter(&self) -> Option<usize> {
         Some(match (self.scheme, self.method()) {
+            (_, Method::Sections) => return None,
             (Scheme::BsplineSurface, Method::LeastSquares) => {
                 LsqSurfaceOptions::DEFAULT.max_iterations
             }
@@ -864,6 +922,17 @@ impl FitSpec {
             max_control: self.max_control,
             acceleration: self.acceleration_in_force(),
             ..d
+        }
+    }
+
+    fn sections_options(&self) -> SectionsOptions {
+        let d = SectionsOptions::DEFAULT;
+        SectionsOptions {
+            degree: self.degree.unwrap_or(d.degree),
+            tol_pct: self.tolerances().max_pct.unwrap_or(d.tol_pct),
+            rows: self.rows,
+            corner_angle_deg: self.corner_angle.unwrap_or(d.corner_angle_deg),
+            curvature_jump: self.curvature_jump.unwrap_or(d.curvature_jump),
         }
     }
 

@@ -8,7 +8,7 @@
 export type Scheme =
   | 'loop' | 'catmull-clark' | 'doo-sabin' | 'bspline-surface' | 'bspline-curve' | 'chaikin-curve';
 /** How control points are found (`methodsFor(scheme)` lists a scheme's, its default first). */
-export type Method = 'geometric' | 'least-squares' | 'knots';
+export type Method = 'geometric' | 'least-squares' | 'knots' | 'sections';
 /** How a fit stands: still iterating, or why it stopped. */
 export type FitStatus = 'running' | 'converged' | 'max_iterations' | 'stalled';
 /** The exports of a fit; `exportsFor(scheme)` says which a scheme offers. */
@@ -52,6 +52,7 @@ export interface FitSpec {
   folded?: 'fail' | 'exclude' | 'keep';
   cornerAngle?: number | null;
   curvatureJump?: number | null;
+  rows?: number | null;
 }
 
 /** A `FitSpec` with every field written out, as `defaultSpec` gives it (`null`: the data decides). */
@@ -170,6 +171,24 @@ export interface SurfaceDetails {
   control_points_u: number;
   control_points_v: number;
   folded_points: number;
+  /** The face the STEP and IGES exports write: the outline of the data's parameters. */
+  trim: TrimReport | { untrimmed: string };
+  /** Sections method: rows fitted, σ of the signed distances (model units and %) at the end
+   * and with the multiple knots only. */
+  rows?: number;
+  sigma?: number;
+  sigma_pct?: number;
+  sigma_features?: number;
+  sigma_features_pct?: number;
+}
+
+/** A surface fit's trim: its loops and vertices, loops left out, and areas (model units²). */
+export interface TrimReport {
+  loops: number;
+  vertices: number;
+  dropped_loops: number;
+  trimmed_area: number;
+  data_area: number;
 }
 
 /** The fields only a curve fit reports (`features`, `corners`, `std_pct` for the knots method). */

@@ -327,6 +327,8 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     await page.uncheck('#show-vectors');
     await pickSample(page, 'bun000-points.xyz', '5,032');
     assert.equal(await page.inputValue('#fit-scheme'), 'bspline-surface');
+    const methods = await page.$$eval('#fit-method option', (os) => os.map((o) => o.value));
+    assert.ok(methods.includes('sections'), `methodsFor('bspline-surface') offers sections: ${methods}`);
     const stats = await playToEnd(page);
     console.log(`[e2e] ${backend.name} bspline-surface: ${JSON.stringify(stats)}`);
     assert.equal(stats.scheme, 'bspline-surface');

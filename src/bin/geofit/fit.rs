@@ -126,6 +126,10 @@ pub struct Args {
     /// Curves, knots method: second-derivative jump that makes a double knot, 1 / diagonal.
     #[arg(long)]
     curvature_jump: Option<f64>,
+    /// B-spline surface, sections method: points per row of an XYZ file in rows (default: a
+    /// row starts at every jump; a range scan's rows are its grid's).
+    #[arg(long)]
+    rows: Option<usize>,
     /// Write the report (set-up, final errors, times, per-iteration history) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -267,6 +271,7 @@ impl Args {
         spec.view = self.view.map(|v| v.to_array());
         spec.folded = self.folded.unwrap_or(spec.folded);
         (spec.corner_angle, spec.curvature_jump) = (self.corner_angle, self.curvature_jump);
+        spec.rows = self.rows;
         self.check_outputs()?;
         Ok(spec)
     }

@@ -1,6 +1,7 @@
 //! Fitting one tensor-product B-spline surface to a scan: by error vectors
 //! ([`GeometricSurfaceFitter`], SPEC §1 applied to B-splines) or by smoothed least squares
-//! ([`LsqSurfaceFitter`], SPEC §2). Both share the grid they start from and split
+//! ([`LsqSurfaceFitter`], SPEC §2), or as a family of section curves ([`SectionsFitter`],
+//! skinning, SPEC §3 on gridded data). The first two share the grid they start from and split
 //! ([`SurfaceGrid`]), the parameterisation, the per-patch tolerance test and the drawable
 //! shapes here.
 
@@ -83,6 +84,7 @@ mod least_squares;
 mod normal_system;
 mod parameterize;
 mod patches;
+mod sections;
 mod trim;
 
 pub use geometric::{GeometricSurfaceFitter, GeometricSurfaceOptions};
@@ -91,6 +93,7 @@ pub use parameterize::{
     parameterize, parameterize_on_surface, FoldPolicy, ParamOptions, Parameterization,
 };
 pub use patches::TolMode;
+pub use sections::{detect_rows, grid_rows, SectionsFitter, SectionsOptions};
 pub use trim::SurfaceTrim;
 
 use super::{FitError, FitState, Method, Scheme, Shape, Tolerances};
