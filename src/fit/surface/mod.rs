@@ -358,7 +358,9 @@ pub(crate) fn trimmed_surface_mesh(
     uv: &[[f64; 2]],
     resolution: usize,
 ) -> Option<Shape> {
-    let region = trim::outline_on(s, uv, &TrimOptions::default()).ok()?.region;
+    let region = trim::outline_on(s, uv, &TrimOptions::default())
+        .ok()?
+        .region;
     Some(grid_shape(s, resolution, |u, v| region.contains(u, v)))
 }
 
