@@ -122,7 +122,7 @@ class FitPanel {
     this.showing = false;
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
-    // deviation: the latest frame's distribution of the errors (protocol.js `Deviation`).
+    // deviation: the latest frame's distribution of the errors (the package's `Deviation`).
     this.figures = { lastStats: null, history: [], deviation: null, surfaceTriangles: 0, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
     this.tolUnits = [
       linkTolerance(this.ui.tolAvg, this.ui.tolAvgUnits, () => this.diagonal(), () => this.form.edited.add('tolAvg')),
@@ -259,7 +259,7 @@ class FitPanel {
 
   /**
    * The deviation figures and histogram of a frame.
-   * @param {import('./protocol.js').Deviation} d
+   * @param {import('../pkg/geofit.js').Deviation} d
    */
   showDeviation(d) {
     const u = this.ui;

@@ -137,11 +137,11 @@ export function drawChart(canvas, history, tolerances) {
 }
 
 /**
- * Draws the histogram of signed deviations `dev` (see protocol.js `Deviation`): one bar per
+ * Draws the histogram of signed deviations `dev` (the package's `Deviation`): one bar per
  * bin in the point colour of its centre, the tolerance band ±`dev.tolerance` shaded, 0 and the
  * range's ends labelled. 64 bars: cheap enough for every frame.
  * @param {HTMLCanvasElement} canvas
- * @param {import('./protocol.js').Deviation} dev
+ * @param {import('../pkg/geofit.js').Deviation} dev
  */
 export function drawHistogram(canvas, dev) {
   const ratio = window.devicePixelRatio || 1;
@@ -196,7 +196,7 @@ export function drawHistogram(canvas, dev) {
  * `index,x,y,z,deviation` per point (model units; the deviation signed, + above the surface).
  * @param {Float32Array} positions  x, y, z per point
  * @param {Float32Array} errors  signed deviation per point, in the order of `positions`
- * @param {import('./protocol.js').Deviation} dev
+ * @param {import('../pkg/geofit.js').Deviation} dev
  */
 export function deviationCsv(positions, errors, dev) {
   const figure = (v) => (v == null ? '' : String(v));

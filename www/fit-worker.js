@@ -99,11 +99,6 @@ function play(gen) {
   if (playing) setTimeout(() => play(gen), 0);
 }
 
-    // The FEM export also reports its element quality.
-    const { bytes, quality } = what === 'msh'
-      ? fitter.exportFem({ format: 'msh' })
-      : { bytes: fitter.exportAs(what), quality: undefined };
-    post({ type: MSG.exported, what, bytes, quality }, [bytes.buffer]);
 const handlers = {
   [MSG.start]({ generation: gen, bytes, name, spec }) {
     handlers[MSG.clear]({ generation: gen });
