@@ -35,7 +35,7 @@ use super::{Acceleration, FitError, Fitter, Tolerances};
 use crate::cloud::{ReconstructOptions, SurfaceKind};
 use crate::geom::{Point3, Vec3};
 use crate::io::{LoadedFile, RangeGrid};
-use crate::mesh::PolyMesh;
+use crate::mesh::{FeatureOptions, PolyMesh};
 use crate::subdiv;
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
@@ -274,6 +274,12 @@ pub struct FitSpec {
     /// B-spline surface, sections method: points per row of data without a range grid [rows
     /// start at every jump].
     pub rows: Option<usize>,
+    /// Subdivision and B-spline surfaces: find the data's sharp creases and keep them sharp
+    /// [on].
+    pub creases: bool,
+    /// Subdivision and B-spline surfaces: dihedral angle above which a data edge is a crease,
+    /// degrees [40].
+    pub crease_angle: Option<f64>,
 }
 
 /// One field of [`FitSpec`]: its name (camelCase, as JavaScript and the errors spell it), its
@@ -483,6 +489,20 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
         &[SECTIONS],
         "points per row of gridded data"
     ),
+    info!(
+        "creases",
+        "no-creases",
+        &[LP, CC, DS, BS],
+        &[GEO, LSQ],
+        "keep the data's sharp creases sharp"
+    ),
+    info!(
+        "creaseAngle",
+        "crease-angle",
+        &[LP, CC, DS, BS],
+        &[GEO, LSQ],
+        "dihedral angle that makes a crease, degrees"
+    ),
 ];
 
 /// Calls `$m!` with every field of [`FitSpec`] but the scheme, each with its name: the one list
@@ -496,7 +516,8 @@ macro_rules! spec_fields {
             cloud: "cloud", outliers: "outliers", use_grid: "useGrid", closed: "closed",
             degree: "degree", tol_mode: "tolMode", beta2: "beta2", beta3: "beta3",
             solves: "solves", view: "view", folded: "folded", corner_angle: "cornerAngle",
-            curvature_jump: "curvatureJump", rows: "rows")
+            curvature_jump: "curvatureJump", rows: "rows", creases: "creases",
+            crease_angle: "creaseAngle")
     };
 }
 
@@ -534,6 +555,8 @@ impl FitSpec {
         corner_angle: None,
         curvature_jump: None,
         rows: None,
+        creases: true,
+        crease_angle: None,
     };
 
     /// A fit of `scheme` with every other field at its default.
@@ -588,6 +611,7 @@ impl FitSpec {
             acceleration: (method == Method::Geometric).then(|| spec.acceleration_in_force()),
             ..spec.clone()
         };
+        d.crease_angle = Some(FeatureOptions::DEFAULT_ANGLE_DEG);
         match scheme {
             Scheme::Loop | Scheme::CatmullClark | Scheme::DooSabin => {
                 let o = SubdivFitOptions::DEFAULT;
@@ -700,6 +724,12 @@ impl FitSpec {
             .filter(|v| !Vec3::from(*v).is_finite() || Vec3::from(*v).length() == 0.0)
         {
             return bad("view", format!("{v:?} is not a direction"));
+        }
+        if let Some(f) = self.feature_options() {
+            f.validate().map_err(|e| FitError::InvalidOption {
+                name: "creaseAngle",
+                reason: e.to_string(),
+            })?;
         }
         match self.scheme {
             Scheme::Loop | Scheme::CatmullClark | Scheme::DooSabin => {
@@ -832,6 +862,16 @@ impl FitSpec {
             refine_growth: self.refine_growth.unwrap_or(d.refine_growth),
             ..d
         }
+    }
+
+    /// How the data's creases are found, or `None` when [`FitSpec::creases`] is off.
+    pub fn feature_options(&self) -> Option<FeatureOptions> {
+        self.creases.then(|| FeatureOptions {
+            angle_deg: self
+                .crease_angle
+                .unwrap_or(FeatureOptions::DEFAULT_ANGLE_DEG),
+            ..FeatureOptions::default()
+        })
     }
 
     fn cloud_options(&self) -> ReconstructOptions {

@@ -53,6 +53,8 @@ export interface FitSpec {
   cornerAngle?: number | null;
   curvatureJump?: number | null;
   rows?: number | null;
+  creases?: boolean;
+  creaseAngle?: number | null;
 }
 
 /** A `FitSpec` with every field written out, as `defaultSpec` gives it (`null`: the data decides). */
