@@ -2,12 +2,15 @@
 //! curvature, optionally trimmed by an inside test.
 
 use super::grading::{equidistribute, intervals, max_curvature, resolve_size};
-use super::{FemError, FemMesh, FemOptions};
+use super::{FemError, FemMesh, FemOptions, FemSize, MAX_ELEMENTS};
 use crate::geom::{Aabb, Point3, Vec3};
 use crate::spline::{BSplineSurface, KnotVector, MAX_DEGREE};
 
 /// The FEM quad mesh of `surface` (see the [module](super) docs). `inside(u, v)`, when given,
-/// trims it: elements whose four corners are all outside are dropped.
+/// trims it: elements whose four corners are all outside are dropped. A count asks for that
+/// many elements inside: the lines are laid out once for the whole domain, then once more with
+/// the count scaled by the share of elements the trim kept (a second pass only when it dropped
+/// some), so a trimmed mesh is about as fine as the count says, not coarser by the trim.
 pub fn mesh_bspline(
     surface: &BSplineSurface,
     options: &FemOptions,
@@ -15,37 +18,76 @@ pub fn mesh_bspline(
 ) -> Result<FemMesh, FemError> {
     options.validate()?;
     let field = SizeField::sample(surface);
-    let g = options.grading;
-    let scale = Aabb::from_points(surface.control_points()).map_or(1.0, |b| b.diagonal());
-    let scale = if scale > 0.0 { scale } else { 1.0 };
-    let l = resolve_size(options.size, scale, |l| {
+    let grid = Grid::lay_out(surface, &field, options, options.size)?;
+    let (kept, total) = grid.quads(inside);
+    let share = kept.len() as f64 / total.max(1) as f64;
+    let (grid, quads) = match options.size {
+        FemSize::Count(n) if share > 0.0 && share < 1.0 => {
+            let scaled = ((n as f64 / share).round() as usize).min(MAX_ELEMENTS);
+            let grid = Grid::lay_out(surface, &field, options, FemSize::Count(scaled))?;
+            let (quads, _) = grid.quads(inside);
+            (grid, quads)
+        }
+        _ => (grid, kept),
+    };
+    let (nodes, normals) = eval_grid(surface, &grid.us, &grid.vs);
+    FemMesh::assemble(nodes, normals, quads)
+}
+
+/// The u and v lines of a FEM mesh.
+struct Grid {
+    us: Vec<f64>,
+    vs: Vec<f64>,
+}
+
+impl Grid {
+    /// The lines for `size` over the whole domain, graded by `field`.
+    fn lay_out(
+        surface: &BSplineSurface,
+        field: &SizeField,
+        options: &FemOptions,
+        size: FemSize,
+    ) -> Result<Grid, FemError> {
+        let g = options.grading;
+        let scale = Aabb::from_points(surface.control_points()).map_or(1.0, |b| b.diagonal());
+        let scale = if scale > 0.0 { scale } else { 1.0 };
+        let l = resolve_size(size, scale, |l| {
+            let (wu, wv) = field.weights(l, g);
+            intervals(integral(&field.u, &wu)) as f64 * intervals(integral(&field.v, &wv)) as f64
+        })?;
         let (wu, wv) = field.weights(l, g);
-        intervals(integral(&field.u, &wu)) as f64 * intervals(integral(&field.v, &wv)) as f64
-    })?;
-    let (wu, wv) = field.weights(l, g);
-    let us = equidistribute(&field.u, &wu, intervals(integral(&field.u, &wu)));
-    let vs = equidistribute(&field.v, &wv, intervals(integral(&field.v, &wv)));
-    let (nodes, normals) = eval_grid(surface, &us, &vs);
-    let nv = vs.len();
-    let id = |i: usize, j: usize| (i * nv + j) as u32;
-    let keep: Option<Vec<bool>> = inside.map(|f| {
-        us.iter()
-            .flat_map(|&u| vs.iter().map(move |&v| f(u, v)))
-            .collect()
-    });
-    let mut quads = Vec::with_capacity((us.len() - 1) * (nv - 1));
-    for i in 0..us.len() - 1 {
-        for j in 0..nv - 1 {
-            let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
-            if keep
-                .as_ref()
-                .is_none_or(|k| q.iter().any(|&c| k[c as usize]))
-            {
-                quads.push(q);
+        Ok(Grid {
+            us: equidistribute(&field.u, &wu, intervals(integral(&field.u, &wu))),
+            vs: equidistribute(&field.v, &wv, intervals(integral(&field.v, &wv))),
+        })
+    }
+
+    /// The quads `inside` keeps (all without one; node `(i, j)` is `i * vs.len() + j`), and
+    /// how many there are in all.
+    fn quads(&self, inside: Option<&dyn Fn(f64, f64) -> bool>) -> (Vec<[u32; 4]>, usize) {
+        let nv = self.vs.len();
+        let id = |i: usize, j: usize| (i * nv + j) as u32;
+        let keep: Option<Vec<bool>> = inside.map(|f| {
+            self.us
+                .iter()
+                .flat_map(|&u| self.vs.iter().map(move |&v| f(u, v)))
+                .collect()
+        });
+        let total = (self.us.len() - 1) * (nv - 1);
+        let mut quads = Vec::with_capacity(total);
+        for i in 0..self.us.len() - 1 {
+            for j in 0..nv - 1 {
+                let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+                if keep
+                    .as_ref()
+                    .is_none_or(|k| q.iter().any(|&c| k[c as usize]))
+                {
+                    quads.push(q);
+                }
             }
         }
+        (quads, total)
     }
-    FemMesh::assemble(nodes, normals, quads)
 }
 
 /// ∫ w dt over the samples (trapezoid rule).

@@ -44,9 +44,10 @@ pub use grading::MAX_REFINEMENT;
 pub use limit::mesh_limit;
 pub use quality::FemQuality;
 
-use crate::fit::{Fitter, Spline};
+use crate::fit::{outline_on, Fitter, Spline};
 use crate::geom::{Point3, Vec3};
 use crate::mesh::{MeshError, PolyMesh};
+use crate::spline::{BSplineSurface, TrimOptions, TrimRegion};
 use thiserror::Error;
 
 /// The most elements a FEM mesh may have (about 0.5 GB of nodes and quads): a size or count
@@ -73,6 +74,10 @@ pub struct FemOptions {
     /// largest principal curvature, so where the radius of curvature is far below L there are
     /// about g elements per radian of turning. 0 gives uniform elements; default 4.
     pub grading: f64,
+    /// A fitted B-spline surface is meshed only over its data's outline, the region its STEP
+    /// and IGES exports are trimmed to (default on): past the data the surface is
+    /// extrapolation, and it folds there more often than anywhere.
+    pub trim: bool,
 }
 
 impl Default for FemOptions {
@@ -80,6 +85,7 @@ impl Default for FemOptions {
         FemOptions {
             size: FemSize::Count(10_000),
             grading: 4.0,
+            trim: true,
         }
     }
 }
@@ -100,6 +106,12 @@ impl FemOptions {
     /// The curvature grading g (0: uniform).
     pub fn with_grading(mut self, grading: f64) -> Self {
         self.grading = grading;
+        self
+    }
+
+    /// Whether a fitted B-spline surface is trimmed to its data ([`FemOptions::trim`]).
+    pub fn with_trim(mut self, trim: bool) -> Self {
+        self.trim = trim;
         self
     }
 
@@ -243,8 +255,12 @@ impl FemMesh {
 
 /// The FEM mesh of a fit's surface: its B-spline surface, or its Catmull–Clark limit surface.
 pub fn mesh_fit(fit: &dyn Fitter, options: &FemOptions) -> Result<FemMesh, FemError> {
-    if let Some(Spline::Surface { surface, .. }) = fit.spline() {
-        return mesh_bspline(surface, options, None);
+    if let Some(Spline::Surface { surface, params }) = fit.spline() {
+        let region = options.trim.then(|| data_region(surface, params)).flatten();
+        let inside = region
+            .as_ref()
+            .map(|r| move |u: f64, v: f64| r.contains(u, v));
+        return mesh_bspline(surface, options, inside.as_ref().map(|f| f as _));
     }
     match fit.subdiv_surface() {
         Some(surface) => mesh_limit(surface, options),
@@ -253,4 +269,13 @@ pub fn mesh_fit(fit: &dyn Fitter, options: &FemOptions) -> Result<FemMesh, FemEr
                 .into(),
         }),
     }
+}
+
+/// The outline of the data's parameters on `surface`, as the exports trim to; `None` where the
+/// data give no region (too few points, all in a line), and the mesh is then untrimmed as the
+/// exports are.
+fn data_region(surface: &BSplineSurface, params: &[[f64; 2]]) -> Option<TrimRegion> {
+    outline_on(surface, params, &TrimOptions::default())
+        .ok()
+        .map(|o| o.region)
 }

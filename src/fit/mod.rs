@@ -58,6 +58,7 @@ pub use surface::{
 use crate::geom::Point3;
 use crate::mesh::PolyMesh;
 use crate::spline::{BSplineCurve, BSplineSurface};
+pub(crate) use surface::outline_on;
 
 /// What one call of [`Fitter::step`] left the fit in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

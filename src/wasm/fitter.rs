@@ -569,6 +569,7 @@ struct FemJsOptions {
     count: Option<usize>,
     grading: Option<f64>,
     format: Option<String>,
+    untrimmed: Option<bool>,
 }
 
 impl Fitter {
@@ -583,7 +584,7 @@ impl Fitter {
         if o.size.is_some() && o.count.is_some() {
             return Err(JsError::new("FEM options: give size or count, not both"));
         }
-        let mut fem_options = fem::FemOptions::default();
+        let mut fem_options = fem::FemOptions::default().with_trim(!o.untrimmed.unwrap_or(false));
         if let Some(l) = o.size {
             fem_options = fem_options.with_edge(l);
         }

@@ -260,6 +260,8 @@ export interface FemExportOptions {
   grading?: number | null;
   /** `'msh'` (Gmsh 4.1 ASCII, default) or `'obj'` (OBJ quads). */
   format?: 'msh' | 'obj' | null;
+  /** A B-spline surface is meshed over its data's outline (as STEP/IGES are trimmed); `true` meshes the whole domain. */
+  untrimmed?: boolean | null;
 }
 
 /** Element quality of a FEM quad mesh (`FemQuality` in the core). */

@@ -179,6 +179,10 @@ pub struct Args {
     /// (0: uniform; default 4).
     #[arg(long)]
     fem_grading: Option<f64>,
+    /// --fem of a B-spline surface: mesh the whole domain, not only the data's outline (the
+    /// region the STEP and IGES exports are trimmed to).
+    #[arg(long)]
+    fem_untrimmed: bool,
     /// Print only the summary, not one line per iteration.
     #[arg(long, short)]
     quiet: bool,
@@ -323,9 +327,12 @@ impl Args {
             self.fem_size.is_some(),
             self.fem_count.is_some(),
             self.fem_grading.is_some(),
+            self.fem_untrimmed,
         ];
         if self.fem.is_none() && fem_flags.contains(&true) {
-            return Err("--fem-size, --fem-count and --fem-grading need --fem FILE".into());
+            return Err(
+                "--fem-size, --fem-count, --fem-grading and --fem-untrimmed need --fem FILE".into(),
+            );
         }
         Ok(())
     }
@@ -503,7 +510,7 @@ fn write_outputs(
 /// The FEM quad mesh of the fitted surface, written as MSH (OBJ for a `.obj` name), and its
 /// quality printed.
 fn write_fem(fitter: &dyn Fitter, args: &Args, path: &std::path::Path) -> Result<(), String> {
-    let mut options = FemOptions::default();
+    let mut options = FemOptions::default().with_trim(!args.fem_untrimmed);
     if let Some(l) = args.fem_size {
         options = options.with_edge(l);
     }

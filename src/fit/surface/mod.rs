@@ -94,6 +94,7 @@ pub use parameterize::{
 };
 pub use patches::TolMode;
 pub use sections::{detect_rows, grid_rows, SectionsFitter, SectionsOptions};
+pub(crate) use trim::outline_on;
 pub use trim::SurfaceTrim;
 
 use super::{FitError, FitState, Method, Scheme, Shape, Tolerances};
