@@ -15,7 +15,8 @@ pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
 pub use repair::{repair, repair_with, Components, Found, RepairOptions, RepairReport, Repaired};
 pub use simplify::{
-    deviation, foldovers, simplify, simplify_with, simplify_with_report, Deviation, Foldovers,
-    Relaxation, Simplified, SimplifyError, SimplifyOptions, SimplifyReport,
+    deviation, foldovers, simplify, simplify_with, simplify_with_creases, simplify_with_report,
+    CreaseCount, Deviation, Foldovers, Relaxation, Simplified, SimplifyError, SimplifyOptions,
+    SimplifyReport,
 };
 pub use validate::{check_oriented_edges, TopologyError};

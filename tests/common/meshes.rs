@@ -146,3 +146,26 @@ pub fn jitter(mesh: &PolyMesh, amount: f64, seed: u64) -> PolyMesh {
         .collect();
     PolyMesh::try_new(p, mesh.faces()).unwrap()
 }
+
+/// Every triangle split 1 → 4 at its edge midpoints, `levels` times, without moving anything:
+/// the same shape with finer facets.
+pub fn refine_flat(mesh: &PolyMesh, levels: usize) -> PolyMesh {
+    let mut pts = mesh.positions().to_vec();
+    let mut tris = mesh.triangles();
+    for _ in 0..levels {
+        let mut mid = std::collections::HashMap::new();
+        let mut m = |a: u32, b: u32, pts: &mut Vec<Point3>| {
+            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                pts.push((pts[a as usize] + pts[b as usize]) * 0.5);
+                pts.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::new();
+        for [a, b, c] in tris {
+            let (ab, bc, ca) = (m(a, b, &mut pts), m(b, c, &mut pts), m(c, a, &mut pts));
+            next.extend([[a, ab, ca], [ab, b, bc], [ca, bc, c], [ab, bc, ca]]);
+        }
+        tris = next;
+    }
+    PolyMesh::try_new(pts, tris).expect("refined mesh")
+}

@@ -221,6 +221,18 @@ pub struct SimplifyReport {
     pub max_valence: usize,
     /// What repairing the (triangulated) input changed.
     pub repair: RepairReport,
+    /// Crease edges given ([`simplify_with_creases`]) and crease edges of the result.
+    pub creases: CreaseCount,
+}
+
+/// Crease edges before and after a simplification.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[non_exhaustive]
+pub struct CreaseCount {
+    /// Crease edges of the input that are edges of its faces.
+    pub input: usize,
+    /// Crease edges of the result.
+    pub output: usize,
 }
 
 /// A simplified mesh and its report.
@@ -228,6 +240,9 @@ pub struct SimplifyReport {
 pub struct Simplified {
     /// The simplified triangle mesh.
     pub mesh: PolyMesh,
+    /// Its crease edges (vertex pairs, smaller first, sorted): the chains the input's crease
+    /// lines became (empty without [`simplify_with_creases`]).
+    pub creases: Vec<[u32; 2]>,
     /// What was done.
     pub report: SimplifyReport,
 }
@@ -260,6 +275,25 @@ pub fn simplify_with_report(
     target: usize,
     options: &SimplifyOptions,
 ) -> Result<Simplified, SimplifyError> {
+    simplify_with_creases(mesh, target, options, &[])
+}
+
+/// Simplifies `mesh` as [`simplify_with_report`] does, keeping the crease edges `creases`
+/// (vertex pairs of `mesh`, such as [`crate::mesh::detect_features`] finds) as chains of edges
+/// of the result, returned in [`Simplified::creases`].
+///
+/// Crease edges get penalty planes like open boundaries, and collapses keep the lines' course
+/// and nodes: a vertex off the creases may go into one on them, which stays in place; along a
+/// line only a vertex with two crease edges goes, into its neighbour on the line; corners
+/// (three or more crease edges) and dart ends (one) stay, and no line shrinks below three
+/// edges when it is closed. Pairs that are no edge of `mesh` are ignored. With no creases the
+/// result is exactly [`simplify_with_report`]'s.
+pub fn simplify_with_creases(
+    mesh: &PolyMesh,
+    target: usize,
+    options: &SimplifyOptions,
+    creases: &[[u32; 2]],
+) -> Result<Simplified, SimplifyError> {
     options.validate()?;
     if mesh.is_point_cloud() {
         return Err(SimplifyError::NoFaces);
@@ -271,11 +305,12 @@ pub fn simplify_with_report(
         .bbox()
         .filter(|b| b.center().length() > b.diagonal())
         .map_or(Point3::ZERO, |b| b.center());
-    let (mut engine, repair) = working_mesh(mesh, origin, options.boundary_weight)?;
+    let (mut engine, repair) = working_mesh(mesh, origin, creases, options.boundary_weight)?;
+    let input_creases = engine.num_creases();
     let (passes, relaxations) = reduce(&mut engine, target, &options.stages());
     let max_valence = engine.max_valence();
     let live = engine.live();
-    let (mut positions, tris) = engine.into_parts();
+    let (mut positions, tris, creases) = engine.into_parts();
     positions.iter_mut().for_each(|p| *p += origin);
     let starts = (0..=tris.len() as u32 / 3).map(|f| 3 * f).collect();
     let mesh = PolyMesh::from_parts_unchecked(positions, starts, tris);
@@ -288,15 +323,24 @@ pub fn simplify_with_report(
         floor_note: floor_note(&mesh, target),
         max_valence,
         repair,
+        creases: CreaseCount {
+            input: input_creases,
+            output: creases.len(),
+        },
     };
-    Ok(Simplified { mesh, report })
+    Ok(Simplified {
+        mesh,
+        creases,
+        report,
+    })
 }
 
 /// The working mesh of `mesh` (fan-triangulated, and repaired unless it is clean already),
-/// with positions relative to `origin`, and the repair's report.
+/// with positions relative to `origin` and the crease edges `creases`, and the repair's report.
 fn working_mesh(
     mesh: &PolyMesh,
     origin: Point3,
+    creases: &[[u32; 2]],
     boundary_weight: f64,
 ) -> Result<(Engine, RepairReport), SimplifyError> {
     let triangles = triangulated(mesh);
@@ -304,6 +348,7 @@ fn working_mesh(
     let engine = Engine::new(
         &relative(triangles.positions(), origin),
         idx,
+        creases,
         boundary_weight,
     );
     if let Some(report) = verify::clean_report(&engine) {
@@ -311,14 +356,39 @@ fn working_mesh(
     }
     drop(engine);
     let repaired = repair(&triangles)?;
+    let creases = split_creases(
+        creases,
+        &repaired.vertex_origin,
+        repaired.mesh.raw_faces().1,
+    );
     let (pos, _, tris) = repaired.mesh.into_parts();
     if tris.is_empty() {
         return Err(SimplifyError::NoFaces);
     }
     Ok((
-        Engine::new(&relative(&pos, origin), &tris, boundary_weight),
+        Engine::new(&relative(&pos, origin), &tris, &creases, boundary_weight),
         repaired.report,
     ))
+}
+
+/// The crease edges of a repaired mesh (triangles `tris`, vertex `v` a copy of input vertex
+/// `origin[v]`): the sides whose ends are copies of the ends of an input crease edge.
+fn split_creases(creases: &[[u32; 2]], origin: &[u32], tris: &[u32]) -> Vec<[u32; 2]> {
+    if creases.is_empty() {
+        return Vec::new();
+    }
+    let key = |x: u32, y: u32| (x.min(y), x.max(y));
+    let wanted: std::collections::HashSet<(u32, u32)> =
+        creases.iter().map(|&[x, y]| key(x, y)).collect();
+    let mut out: Vec<[u32; 2]> = tris
+        .chunks_exact(3)
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .filter(|&(x, y)| wanted.contains(&key(origin[x as usize], origin[y as usize])))
+        .map(|(x, y)| [x.min(y), x.max(y)])
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
 }
 
 /// `pos` relative to `origin` (borrowed when that is the origin itself: no copy).
