@@ -48,7 +48,7 @@ fn control_mesh(scheme: Scheme) -> PolyMesh {
 /// hundred iterations.
 fn reproduce(scheme: Scheme, max_iter: usize) -> (FitStatus, f64, usize) {
     let control = control_mesh(scheme);
-    let truth = surface_of(scheme, &control).expect("limit surface");
+    let truth = surface_of(scheme, &control, &[]).expect("limit surface");
     let data = sample(&truth, 40, &mut Rng(9));
     let start = radially_perturbed(&control, 0.05, &mut Rng(10));
     let options = SubdivFitOptions::default()

@@ -79,14 +79,14 @@ fn loop_refinement_with_flips_stays_manifold_and_finite() {
 fn loop_split_keeps_the_limit_surface() {
     use geofit::subdiv::adaptive::{split_triangles, SplitRule};
     let control = perturbed(&sphere_mesh(1), 0.1, &mut Rng(31));
-    let truth = surface_of(Scheme::Loop, &control).expect("surface");
+    let truth = surface_of(Scheme::Loop, &control, &[]).expect("surface");
     let data = sample(&truth, 20, &mut Rng(32));
     let n = control.num_faces();
     for (marked, bound) in [
         (vec![true; n], 1e-6),
         ((0..n).map(|f| f % 3 == 0).collect(), 5.0),
     ] {
-        let refined = split_triangles(&control, &marked, SplitRule::Loop).expect("split");
+        let refined = split_triangles(&control, &marked, SplitRule::Loop, &[]).expect("split");
         let fitter = SubdivFitter::<SubdivSurface>::try_new(
             &data,
             refined,

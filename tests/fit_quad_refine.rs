@@ -85,7 +85,7 @@ fn canonical(f: &[u32]) -> Vec<u32> {
 
 /// A closed quad mesh: the octahedral sphere, one Catmull–Clark step (valences 3, 4 and 6).
 fn quad_sphere() -> PolyMesh {
-    surface_of(Scheme::CatmullClark, &sphere_mesh(1))
+    surface_of(Scheme::CatmullClark, &sphere_mesh(1), &[])
         .expect("quad sphere")
         .control_mesh()
         .to_poly_mesh()
@@ -103,9 +103,9 @@ fn refinement_is_conforming_on_open_and_closed_meshes() {
     for mesh in [grid, quad_sphere(), cube()] {
         for seed in 0..6 {
             let marked = marks(mesh.num_faces(), seed, 0.15);
-            let refined = split_quads(&mesh, &marked).expect("split");
+            let refined = split_quads(&mesh, &marked, &[]).expect("split");
             assert_conforming_refinement(&mesh, &refined, &marked);
-            surface_of(Scheme::CatmullClark, &refined).expect("valid CC control mesh");
+            surface_of(Scheme::CatmullClark, &refined, &[]).expect("valid CC control mesh");
         }
     }
 }
@@ -115,7 +115,7 @@ fn refinement_stays_local() {
     let mesh = quad_grid(20, |_, _| 0.0);
     let mut marked = vec![false; 400];
     marked[10 * 20 + 10] = true;
-    let refined = split_quads(&mesh, &marked).expect("split");
+    let refined = split_quads(&mesh, &marked, &[]).expect("split");
     // One quad 1→4 plus a closing ring: a handful of new points, not a whole strip.
     assert!(refined.num_vertices() - mesh.num_vertices() <= 16);
     let old: HashSet<Vec<u32>> = mesh.faces().map(canonical).collect();
@@ -133,9 +133,9 @@ fn limit_surface_is_unchanged_away_from_the_split_and_close_near_it() {
     for f in [5 * 12 + 5, 5 * 12 + 6, 6 * 12 + 5] {
         marked[f] = true;
     }
-    let refined = split_quads(&mesh, &marked).expect("split");
-    let before = surface_of(Scheme::CatmullClark, &mesh).expect("before");
-    let after = surface_of(Scheme::CatmullClark, &refined).expect("after");
+    let refined = split_quads(&mesh, &marked, &[]).expect("split");
+    let before = surface_of(Scheme::CatmullClark, &mesh, &[]).expect("before");
+    let after = surface_of(Scheme::CatmullClark, &refined, &[]).expect("after");
     // Faces whose whole neighbourhood (every face at one of its corners) is unchanged.
     let old_faces: HashMap<Vec<u32>, usize> = mesh
         .faces()
@@ -232,12 +232,12 @@ fn refined_fit_is_deterministic() {
 #[test]
 fn bad_input_is_an_error() {
     let grid = quad_grid(2, |_, _| 0.0);
-    assert!(split_quads(&grid, &[true; 3]).is_err());
-    assert!(split_quads(&sphere_mesh(0), &[true; 8]).is_err());
+    assert!(split_quads(&grid, &[true; 3], &[]).is_err());
+    assert!(split_quads(&sphere_mesh(0), &[true; 8], &[]).is_err());
     // Inconsistent orientation: the second quad reuses the first one's edge in its direction.
     let p = (0..6).map(|i| Point3::new(i as f64, 0.0, 0.0)).collect();
     let flipped = PolyMesh::try_new(p, [[0u32, 1, 2, 3], [1, 2, 4, 5]]).expect("polygons");
-    assert!(split_quads(&flipped, &[true, false]).is_err());
+    assert!(split_quads(&flipped, &[true, false], &[]).is_err());
 }
 
 proptest! {
@@ -253,10 +253,10 @@ proptest! {
             common::meshes::jitter(&quad_grid(7, |x, y| 0.2 * (x - y).sin()), 0.2, seed)
         };
         let marked = marks(mesh.num_faces(), seed, density);
-        let once = split_quads(&mesh, &marked).expect("split");
+        let once = split_quads(&mesh, &marked, &[]).expect("split");
         assert_conforming_refinement(&mesh, &once, &marked);
         let again = marks(once.num_faces(), seed + 1, density);
-        let twice = split_quads(&once, &again).expect("split again");
+        let twice = split_quads(&once, &again, &[]).expect("split again");
         assert_conforming_refinement(&once, &twice, &again);
     }
 }

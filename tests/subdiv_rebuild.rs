@@ -77,8 +77,8 @@ fn loop_rebuild_after_a_local_split_and_flips_equals_a_fresh_build() {
         let mut marked = vec![false; control.num_faces()];
         marked[control.num_faces() / 2] = true;
         marked[1] = true;
-        let mut refined = split_triangles(&control, &marked, SplitRule::Loop).expect("split");
-        improve_by_flips(&mut refined, 3, control.num_vertices() as u32).expect("flips");
+        let mut refined = split_triangles(&control, &marked, SplitRule::Loop, &[]).expect("split");
+        improve_by_flips(&mut refined, 3, control.num_vertices() as u32, &[]).expect("flips");
         let kept = check_rebuild(&old, ControlMesh::try_new(&refined).unwrap());
         assert!(
             kept * 2 > control.num_faces(),
@@ -93,8 +93,13 @@ fn loop_rebuild_after_splitting_everything_keeps_nothing() {
     let control = perturbed(&sphere_mesh(1), 0.05, &mut Rng(5));
     let old = SubdivSurface::try_new(Scheme::Loop, ControlMesh::try_new(&control).unwrap())
         .expect("surface");
-    let refined = split_triangles(&control, &vec![true; control.num_faces()], SplitRule::Loop)
-        .expect("split");
+    let refined = split_triangles(
+        &control,
+        &vec![true; control.num_faces()],
+        SplitRule::Loop,
+        &[],
+    )
+    .expect("split");
     assert_eq!(
         check_rebuild(&old, ControlMesh::try_new(&refined).unwrap()),
         0
@@ -107,7 +112,7 @@ fn catmull_clark_rebuild_after_a_local_split_equals_a_fresh_build() {
     let quads = quadrangulate(&ControlMesh::try_new(&tri).unwrap()).expect("quads");
     let control = quads.to_poly_mesh().expect("poly");
     let old = SubdivSurface::try_new(Scheme::CatmullClark, quads).expect("surface");
-    let refined = split_quads(&control, &marked_every(&control, 17)).expect("split");
+    let refined = split_quads(&control, &marked_every(&control, 17), &[]).expect("split");
     let kept = check_rebuild(&old, ControlMesh::try_new(&refined).unwrap());
     assert!(kept > 0, "no patch kept");
 }

@@ -89,7 +89,7 @@ pub enum FitError {
     /// use geofit::geom::Point3;
     /// use geofit::mesh::PolyMesh;
     /// let cloud = PolyMesh::try_new(vec![Point3::ZERO; 3], Vec::<[u32; 3]>::new()).unwrap();
-    /// assert_eq!(initial_control(&cloud, None), Err(FitError::NoFaces));
+    /// assert_eq!(initial_control(&cloud, None, None), Err(FitError::NoFaces));
     /// ```
     #[error("invalid control mesh: the data has no faces; reconstruct a mesh from the points or give a control mesh")]
     NoFaces,
@@ -114,7 +114,7 @@ pub enum FitError {
     /// // Two triangles that run their shared edge the same way.
     /// let p = vec![Point3::ZERO, Point3::X, Point3::Y, Point3::ONE];
     /// let mesh = PolyMesh::try_new(p, vec![[0, 1, 2], [0, 1, 3]]).unwrap();
-    /// let err = surface_of(Scheme::Loop, &mesh).err();
+    /// let err = surface_of(Scheme::Loop, &mesh, &[]).err();
     /// assert!(matches!(err, Some(FitError::ControlMesh(_))), "{err:?}");
     /// ```
     #[error("invalid control mesh: {0}")]
@@ -238,7 +238,7 @@ pub enum FitError {
     ///     vec![vec![0u32, 1, 2, 3]],
     /// )
     /// .unwrap();
-    /// let err = surface_of(Scheme::Loop, &quad).err();
+    /// let err = surface_of(Scheme::Loop, &quad, &[]).err();
     /// assert!(matches!(err, Some(FitError::Subdiv(_))), "{err:?}");
     /// ```
     #[error(transparent)]

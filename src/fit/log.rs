@@ -2,7 +2,9 @@
 //! and what happened to the data on intake.
 
 use super::reference::BackStats;
-use super::{ErrorStats, FitStatus, IterationRecord, ReconstructionReport, StrayPoints};
+use super::{
+    CreaseReport, ErrorStats, FitStatus, IterationRecord, ReconstructionReport, StrayPoints,
+};
 use crate::mesh::SimplifyReport;
 use web_time::Instant;
 
@@ -16,6 +18,7 @@ pub struct FitLog {
     fit_s: f64,
     reconstruction: Option<ReconstructionReport>,
     simplification: Option<SimplifyReport>,
+    creases: Option<CreaseReport>,
     strays: Option<StrayPoints>,
 }
 
@@ -30,6 +33,7 @@ impl FitLog {
             fit_s: 0.0,
             reconstruction: None,
             simplification: None,
+            creases: None,
             strays: None,
         }
     }
@@ -130,6 +134,16 @@ impl FitLog {
         self.strays.as_ref()
     }
 
+    /// The sharp features found on the data and kept on the initial control mesh.
+    pub fn creases(&self) -> Option<&CreaseReport> {
+        self.creases.as_ref()
+    }
+
+    /// Records the sharp features found and kept.
+    pub(crate) fn set_creases(&mut self, report: Option<CreaseReport>) {
+        self.creases = report;
+    }
+
     /// Records the data points left out as strays.
     pub(crate) fn set_strays(&mut self, strays: Option<StrayPoints>) {
         self.strays = strays;
@@ -165,6 +179,12 @@ impl FitLog {
             if let Some(floor) = &s.floor_note {
                 notes.push(floor.clone());
             }
+        }
+        if let Some(c) = self.creases.as_ref().filter(|c| c.edges > 0) {
+            notes.push(format!(
+                "sharp features at {}°: {}; {} crease edges tagged on the control mesh",
+                c.angle_deg, c.summary, c.control_edges
+            ));
         }
         notes
     }

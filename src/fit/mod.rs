@@ -45,8 +45,8 @@ pub use state::{FitState, BACK_TOLERANCE_FACTOR};
 pub use stats::{ErrorStats, IterationRecord, Tolerances};
 pub use strays::StrayPoints;
 pub use subdiv::{
-    default_initial_count, initial_control, surface_of, ControlSurface, ReconstructionReport,
-    SubdivFitOptions, SubdivFitter, Weighting,
+    default_initial_count, initial_control, surface_of, ControlSurface, CreaseReport,
+    ReconstructionReport, SubdivFitOptions, SubdivFitter, Weighting,
 };
 pub use surface::{
     detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, FoldPolicy,

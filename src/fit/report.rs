@@ -2,7 +2,8 @@
 //! builder, [`FitReport::of`], for every engine.
 
 use super::{
-    DeviationStats, FitStatus, Fitter, IterationRecord, ReconstructionReport, StrayPoints,
+    CreaseReport, DeviationStats, FitStatus, Fitter, IterationRecord, ReconstructionReport,
+    StrayPoints,
 };
 use crate::mesh::SimplifyReport;
 use serde::Serialize;
@@ -52,6 +53,10 @@ pub struct FitReport {
     /// changed (`simplification.repair`); absent when a control mesh was given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simplification: Option<SimplifyReport>,
+    /// The sharp features found on the data and kept sharp on the initial control mesh
+    /// (absent when crease detection is off or the fit is no subdivision fit).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub creases: Option<CreaseReport>,
     /// The data points left out as strays (absent when there were none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub strays: Option<StrayPoints>,
@@ -102,6 +107,7 @@ impl FitReport {
             deviation,
             reconstruction: log.reconstruction().cloned(),
             simplification: log.simplification().cloned(),
+            creases: log.creases().cloned(),
             strays: log.strays().cloned(),
             intake: log.intake_notes(),
             precompute_s,

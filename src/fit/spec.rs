@@ -274,11 +274,11 @@ pub struct FitSpec {
     /// B-spline surface, sections method: points per row of data without a range grid [rows
     /// start at every jump].
     pub rows: Option<usize>,
-    /// Subdivision and B-spline surfaces: find the data's sharp creases and keep them sharp
-    /// [on].
+    /// Subdivision: find the data's sharp creases and keep them sharp (QEM keeps them as edge
+    /// chains, the control mesh tags them, refinement carries them) [off: see docs/features.md
+    /// for why it is not yet the default].
     pub creases: bool,
-    /// Subdivision and B-spline surfaces: dihedral angle above which a data edge is a crease,
-    /// degrees [40].
+    /// Subdivision: dihedral angle above which a data edge is a crease, degrees [40].
     pub crease_angle: Option<f64>,
 }
 
@@ -491,15 +491,15 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
     ),
     info!(
         "creases",
-        "no-creases",
-        &[LP, CC, DS, BS],
+        "creases",
+        &[LP, CC, DS],
         &[GEO, LSQ],
         "keep the data's sharp creases sharp"
     ),
     info!(
         "creaseAngle",
         "crease-angle",
-        &[LP, CC, DS, BS],
+        &[LP, CC, DS],
         &[GEO, LSQ],
         "dihedral angle that makes a crease, degrees"
     ),
@@ -555,7 +555,7 @@ impl FitSpec {
         corner_angle: None,
         curvature_jump: None,
         rows: None,
-        creases: true,
+        creases: false,
         crease_angle: None,
     };
 
@@ -769,6 +769,7 @@ impl FitSpec {
                     scheme.subdivision().unwrap_or(subdiv::Scheme::Loop),
                     data.control,
                     self.initial,
+                    self.feature_options().as_ref(),
                     self.subdiv_options(),
                 )?)
             }
@@ -1011,6 +1012,10 @@ setters!(FitSpec {
     with_degree(degree: Option<usize>) => |s| s.degree;
     /// Sets whether a curve is closed.
     with_closed(closed: Option<bool>) => |s| s.closed;
+    /// Sets whether the data's creases are found and kept sharp.
+    with_creases(creases: bool) => |s| s.creases;
+    /// Sets the crease angle, degrees.
+    with_crease_angle(crease_angle: Option<f64>) => |s| s.crease_angle;
 });
 
 #[cfg(test)]

@@ -115,7 +115,7 @@ impl ControlSurface for Linear {
         patch as usize
     }
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
-        Ok(split_triangles(control, marked, SplitRule::Midpoint)?)
+        Ok(split_triangles(control, marked, SplitRule::Midpoint, &[])?)
     }
 }
 

@@ -130,11 +130,11 @@ pub struct Args {
     /// row starts at every jump; a range scan's rows are its grid's).
     #[arg(long)]
     rows: Option<usize>,
-    /// Subdivision and B-spline surfaces: do not look for sharp creases in the data (every
-    /// edge is fitted smooth).
+    /// Subdivision: find the data's sharp creases and keep them sharp (QEM keeps them as edge
+    /// chains of the control mesh, which tags them as creases).
     #[arg(long)]
-    no_creases: bool,
-    /// Subdivision and B-spline surfaces: dihedral angle above which a data edge is a crease,
+    creases: bool,
+    /// Subdivision, with --creases: dihedral angle above which a data edge is a crease,
     /// degrees.
     #[arg(long)]
     crease_angle: Option<f64>,
@@ -284,7 +284,7 @@ impl Args {
         spec.folded = self.folded.unwrap_or(spec.folded);
         (spec.corner_angle, spec.curvature_jump) = (self.corner_angle, self.curvature_jump);
         spec.rows = self.rows;
-        (spec.creases, spec.crease_angle) = (!self.no_creases, self.crease_angle);
+        (spec.creases, spec.crease_angle) = (self.creases, self.crease_angle);
         self.check_outputs()?;
         Ok(spec)
     }

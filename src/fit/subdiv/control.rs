@@ -7,18 +7,28 @@ use crate::geom::Point3;
 use crate::mesh::{ControlMesh, PolyMesh};
 use crate::subdiv::{adaptive, quadrangulate, LimitSurface, Scheme, SubdivSurface};
 
-/// The limit surface of `control` under `scheme`; quad schemes accept any polygon mesh and turn
-/// it into quads first (one Catmull–Clark step) when it is not all quads.
-pub fn surface_of(scheme: Scheme, control: &PolyMesh) -> Result<SubdivSurface, FitError> {
+/// The limit surface of `control` under `scheme` with the edges `creases` tagged sharp; quad
+/// schemes accept any polygon mesh and turn it into quads first (one Catmull–Clark step, which
+/// keeps the creases) when it is not all quads.
+pub fn surface_of(
+    scheme: Scheme,
+    control: &PolyMesh,
+    creases: &[[u32; 2]],
+) -> Result<SubdivSurface, FitError> {
     Ok(SubdivSurface::try_new(
         scheme,
-        control_mesh_of(scheme, control)?,
+        control_mesh_of(scheme, control, creases)?,
     )?)
 }
 
-/// The control mesh of `control` for `scheme` (quads for the quad schemes).
-fn control_mesh_of(scheme: Scheme, control: &PolyMesh) -> Result<ControlMesh, FitError> {
-    let mesh = ControlMesh::try_new(control)?;
+/// The control mesh of `control` with `creases` tagged, for `scheme` (quads for the quad
+/// schemes).
+fn control_mesh_of(
+    scheme: Scheme,
+    control: &PolyMesh,
+    creases: &[[u32; 2]],
+) -> Result<ControlMesh, FitError> {
+    let mesh = adaptive::tagged(control, creases)?;
     Ok(match scheme {
         Scheme::Loop => mesh,
         _ if mesh.is_quad_mesh() => mesh,
@@ -42,8 +52,15 @@ impl ControlSurface for SubdivSurface {
         Some(self)
     }
 
+    /// The creases carry over: the refinements keep old vertex numbers, so
+    /// [`adaptive::carried_creases`] finds them in the new mesh.
     fn rebuild(&self, control: &PolyMesh) -> Result<Self, FitError> {
-        Ok(self.with_mesh(control_mesh_of(SubdivSurface::scheme(self), control)?)?)
+        let creases = adaptive::carried_creases(self.control_mesh(), control);
+        Ok(self.with_mesh(control_mesh_of(
+            SubdivSurface::scheme(self),
+            control,
+            &creases,
+        )?)?)
     }
 
     /// Loop and Catmull–Clark patches are the control faces. Doo–Sabin patches sit at
@@ -58,10 +75,17 @@ impl ControlSurface for SubdivSurface {
     }
 
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
+        let creases: Vec<[u32; 2]> = self
+            .control_mesh()
+            .creases()
+            .into_iter()
+            .map(|(a, b)| [a, b])
+            .collect();
         Ok(adaptive::refine_marked(
             SubdivSurface::scheme(self),
             control,
             marked,
+            &creases,
         )?)
     }
 
@@ -71,10 +95,12 @@ impl ControlSurface for SubdivSurface {
 
     fn remesh_control(&self, control: &mut PolyMesh) -> Result<usize, FitError> {
         let first_new = self.control_points().len() as u32;
+        let creases = adaptive::carried_creases(self.control_mesh(), control);
         Ok(adaptive::remesh(
             SubdivSurface::scheme(self),
             control,
             first_new,
+            &creases,
         )?)
     }
 }
@@ -89,7 +115,19 @@ impl SubdivFitter<SubdivSurface> {
         scheme: Scheme,
         options: SubdivFitOptions,
     ) -> Result<Self, FitError> {
-        let surface = surface_of(scheme, &initial_control)?;
+        Self::with_creases(data_points, initial_control, &[], scheme, options)
+    }
+
+    /// [`SubdivFitter::try_new`] with the edges `creases` of `initial_control` tagged sharp:
+    /// the limit surface keeps them as crease curves, and refinements carry them on.
+    pub fn with_creases(
+        data_points: &[Point3],
+        initial_control: PolyMesh,
+        creases: &[[u32; 2]],
+        scheme: Scheme,
+        options: SubdivFitOptions,
+    ) -> Result<Self, FitError> {
+        let surface = surface_of(scheme, &initial_control, creases)?;
         SubdivFitter::with_surface(data_points, surface, options)
     }
 }

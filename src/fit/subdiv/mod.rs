@@ -10,7 +10,7 @@ mod setup;
 pub use control::surface_of;
 pub use options::{SubdivFitOptions, Weighting};
 pub(crate) use setup::build_subdiv_fitter;
-pub use setup::{default_initial_count, initial_control, ReconstructionReport};
+pub use setup::{default_initial_count, initial_control, CreaseReport, ReconstructionReport};
 
 use super::accel::Accelerator;
 use super::stall::{stalled, STALL_WINDOW};
@@ -446,7 +446,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 }
                 let old_faces = self.patch_faces_now(&control);
                 let before = self.state.stats().e_rms;
-                self.surface = match self.surface.rebuild(&refined) {
+                let refined_surface = match self.surface.rebuild(&refined) {
                     Ok(surface) => surface,
                     // The split gave a face more neighbours than a patch can depend on (seen
                     // with Doo–Sabin, whose split faces hand extra corners to their
@@ -457,6 +457,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                     }
                     Err(e) => return Err(e),
                 };
+                let previous = std::mem::replace(&mut self.surface, refined_surface);
                 self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
                 self.accel.reset();
                 self.carry_feet_over(&old_faces, &refined)?;
@@ -464,7 +465,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 if after.is_nan() || after > REFINE_WORSE_FACTOR * before {
                     // A split that breaks the surface (seen with Doo–Sabin on open meshes): back
                     // to the control mesh before it, and no more refinement.
-                    self.surface = self.surface.rebuild(&control)?;
+                    self.surface = previous;
                     self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
                     self.search_all_feet()?;
                     return Ok(false);

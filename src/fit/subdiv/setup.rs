@@ -6,7 +6,10 @@ use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
 use crate::fit::{DataSurface, FitError, Fitter};
 use crate::geom::Point3;
 use crate::io::RangeGrid;
-use crate::mesh::{simplify_with_report, PolyMesh, Simplified, SimplifyOptions, SimplifyReport};
+use crate::mesh::{
+    detect_features, simplify_with_creases, FeatureOptions, PolyMesh, Simplified, SimplifyOptions,
+    SimplifyReport,
+};
 use crate::subdiv::{Scheme, SubdivSurface};
 use serde::Serialize;
 use web_time::Instant;
@@ -22,19 +25,63 @@ pub fn default_initial_count(n: usize, used: usize) -> usize {
 }
 
 /// The data mesh repaired and simplified by QEM to `target` vertices (or
-/// [`default_initial_count`]), with the report of both. A point cloud has no faces to
-/// simplify: reconstruct a mesh first (as [`build_subdiv_fitter`] does).
-pub fn initial_control(data: &PolyMesh, target: Option<usize>) -> Result<Simplified, FitError> {
+/// [`default_initial_count`]), with the report of both; with `features`, the data's creases
+/// are detected first and kept by QEM as chains of edges ([`Simplified::creases`]), and the
+/// second value says what was found. A point cloud has no faces to simplify: reconstruct a
+/// mesh first (as [`build_subdiv_fitter`] does).
+pub fn initial_control(
+    data: &PolyMesh,
+    target: Option<usize>,
+    features: Option<&FeatureOptions>,
+) -> Result<(Simplified, Option<CreaseReport>), FitError> {
     if data.is_point_cloud() {
         return Err(FitError::NoFaces);
     }
     let used = used_vertices(data);
     let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
-    Ok(simplify_with_report(
-        data,
-        target,
-        &SimplifyOptions::default(),
-    )?)
+    // Detection fails only on options FitSpec has validated already.
+    let found = features
+        .map(|f| detect_features(data, f).map(|found| (f.angle_deg, found)))
+        .transpose()
+        .map_err(|e| FitError::InvalidOption {
+            name: "creaseAngle",
+            reason: e.to_string(),
+        })?;
+    let edges = found.as_ref().map_or(&[][..], |(_, f)| f.edges.as_slice());
+    let simplified = simplify_with_creases(data, target, &SimplifyOptions::default(), edges)?;
+    let report = found.map(|(angle_deg, f)| CreaseReport {
+        angle_deg,
+        summary: f.summary(),
+        edges: f.edges.len(),
+        lines: f.lines.len(),
+        corners: f.corners.len(),
+        darts: f.darts.len(),
+        length: f.total_length,
+        control_edges: simplified.creases.len(),
+    });
+    Ok((simplified, report))
+}
+
+/// The sharp features found on the data and kept on the initial control mesh: goes into the
+/// fit report as `creases`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CreaseReport {
+    /// The crease angle used, degrees.
+    pub angle_deg: f64,
+    /// One line for people ([`crate::mesh::Features::summary`]).
+    pub summary: String,
+    /// Crease edges of the data mesh.
+    pub edges: usize,
+    /// Crease lines they form.
+    pub lines: usize,
+    /// Corners (three or more crease edges).
+    pub corners: usize,
+    /// Dart ends (a line ending inside the surface).
+    pub darts: usize,
+    /// Total length of the crease edges, model units.
+    pub length: f64,
+    /// Crease edges tagged sharp on the initial control mesh.
+    pub control_edges: usize,
 }
 
 /// What [`build_subdiv_fitter`] made of bare points before simplifying: goes into the fit
@@ -63,6 +110,9 @@ pub struct ReconstructionReport {
 /// removal), using the scanner's `grid` when there is one; the fit then runs on the original
 /// points (less those removed as outliers), not on the reconstructed vertices.
 /// The reconstruction, when there was one, is in the fitter's log.
+/// With `features`, the data's creases are found and kept sharp ([`initial_control`]); a
+/// given control mesh is taken as it is.
+#[allow(clippy::too_many_arguments)] // the set-up's inputs, all from one FitSpec
 pub(crate) fn build_subdiv_fitter(
     data: &PolyMesh,
     grid: Option<&RangeGrid>,
@@ -70,38 +120,61 @@ pub(crate) fn build_subdiv_fitter(
     scheme: Scheme,
     control: Option<&PolyMesh>,
     initial: Option<usize>,
+    features: Option<&FeatureOptions>,
     options: SubdivFitOptions,
 ) -> Result<SubdivFitter<SubdivSurface>, FitError> {
     options.validate()?;
-    if !data.is_point_cloud() {
-        let (control, simplified) = control_mesh(data, control, initial)?;
-        let mut fitter = SubdivFitter::try_new(data.positions(), control, scheme, options)?
-            .with_reference(DataSurface::of_mesh(data));
-        fitter.log_mut().set_simplification(simplified);
-        return Ok(fitter);
-    }
-    let (points, mesh, report) = reconstruct_cloud(data.positions(), grid, cloud)?;
-    let (control, simplified) = control_mesh(&mesh, control, initial)?;
-    let mut fitter = SubdivFitter::try_new(&points, control, scheme, options)?
-        .with_reference(DataSurface::of_mesh(&mesh));
-    fitter.log_mut().set_reconstruction(Some(report));
-    fitter.log_mut().set_simplification(simplified);
+    let (points, mesh, reconstruction) = if data.is_point_cloud() {
+        let (points, mesh, report) = reconstruct_cloud(data.positions(), grid, cloud)?;
+        (
+            std::borrow::Cow::Owned(points),
+            std::borrow::Cow::Owned(mesh),
+            Some(report),
+        )
+    } else {
+        let points = std::borrow::Cow::Borrowed(data.positions());
+        (points, std::borrow::Cow::Borrowed(data), None)
+    };
+    let start = control_mesh(&mesh, control, initial, features)?;
+    let mut fitter =
+        SubdivFitter::with_creases(&points, start.mesh, &start.creases, scheme, options)?
+            .with_reference(DataSurface::of_mesh(&mesh));
+    fitter.log_mut().set_reconstruction(reconstruction);
+    fitter.log_mut().set_simplification(start.simplified);
+    fitter.log_mut().set_creases(start.crease_report);
     Ok(fitter)
 }
 
-/// The user's control mesh, or the simplification of `mesh` with its report.
+/// The initial control mesh of a fit and how it was made.
+struct Start {
+    mesh: PolyMesh,
+    creases: Vec<[u32; 2]>,
+    simplified: Option<SimplifyReport>,
+    crease_report: Option<CreaseReport>,
+}
+
+/// The user's control mesh, or the simplification of `mesh` with its creases and reports.
 fn control_mesh(
     mesh: &PolyMesh,
     given: Option<&PolyMesh>,
     initial: Option<usize>,
-) -> Result<(PolyMesh, Option<SimplifyReport>), FitError> {
-    match given {
-        Some(control) => Ok((control.clone(), None)),
-        None => {
-            let simplified = initial_control(mesh, initial)?;
-            Ok((simplified.mesh, Some(simplified.report)))
-        }
+    features: Option<&FeatureOptions>,
+) -> Result<Start, FitError> {
+    if let Some(control) = given {
+        return Ok(Start {
+            mesh: control.clone(),
+            creases: Vec::new(),
+            simplified: None,
+            crease_report: None,
+        });
     }
+    let (simplified, crease_report) = initial_control(mesh, initial, features)?;
+    Ok(Start {
+        mesh: simplified.mesh,
+        creases: simplified.creases,
+        simplified: Some(simplified.report),
+        crease_report,
+    })
 }
 
 /// The points to fit (outliers dropped), the mesh reconstructed from them and its report.

@@ -9,10 +9,12 @@
 //! | Catmull–Clark | 1→4 quads closed by transition templates, Catmull–Clark's masks | `quads` |
 //! | Doo–Sabin | marked n-gons into quads, neighbours gain the edge midpoints | `polygons` |
 
+mod creases;
 mod polygons;
 mod quads;
 mod triangles;
 
+pub use creases::{carried_creases, tagged};
 pub use polygons::split_polygons;
 pub use quads::split_quads;
 pub use triangles::{improve_by_flips, split_triangles, triangles_of, SplitRule};
@@ -21,30 +23,34 @@ use super::{Scheme, SubdivError};
 use crate::mesh::PolyMesh;
 
 /// Splits the `marked` faces of `control` (one flag per face) by `scheme`'s local refinement
-/// and what conformity needs around them. Quad schemes need the mesh they evaluate (quads for
-/// Catmull–Clark; any polygons for Doo–Sabin).
+/// and what conformity needs around them, with the crease rules on the edges `creases` (Loop
+/// and Catmull–Clark; Doo–Sabin places midpoints everywhere). Quad schemes need the mesh they
+/// evaluate (quads for Catmull–Clark; any polygons for Doo–Sabin). The crease edges of the
+/// result are [`carried_creases`].
 pub fn refine_marked(
     scheme: Scheme,
     control: &PolyMesh,
     marked: &[bool],
+    creases: &[[u32; 2]],
 ) -> Result<PolyMesh, SubdivError> {
     match scheme {
-        Scheme::Loop => split_triangles(control, marked, SplitRule::Loop),
-        Scheme::CatmullClark => split_quads(control, marked),
+        Scheme::Loop => split_triangles(control, marked, SplitRule::Loop, creases),
+        Scheme::CatmullClark => split_quads(control, marked, creases),
         Scheme::DooSabin => split_polygons(control, marked),
     }
 }
 
 /// Local remeshing after [`refine_marked`]: valence-lowering and thin-triangle-removing edge
-/// flips around the vertices numbered `first_new` and up (Loop; the quad schemes make none).
-/// Returns the number of changes.
+/// flips around the vertices numbered `first_new` and up (Loop; the quad schemes make none),
+/// never of the crease edges `creases`. Returns the number of changes.
 pub fn remesh(
     scheme: Scheme,
     control: &mut PolyMesh,
     first_new: u32,
+    creases: &[[u32; 2]],
 ) -> Result<usize, SubdivError> {
     match scheme {
-        Scheme::Loop => improve_by_flips(control, 3, first_new),
+        Scheme::Loop => improve_by_flips(control, 3, first_new, creases),
         Scheme::CatmullClark | Scheme::DooSabin => Ok(0),
     }
 }

@@ -25,7 +25,7 @@ use crate::mesh::PolyMesh;
 use crate::mesh::{check_oriented_edges, TopologyError};
 use crate::subdiv::{Scheme, SubdivError};
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::{BinaryHeap, HashMap, HashSet};
 
 /// No face / no point.
 const NO: u32 = u32::MAX;
@@ -121,23 +121,35 @@ impl QuadEdges {
 
 /// Splits the `marked` quads of `mesh` 1→4 (one flag per face) and closes the split with
 /// transition templates so the mesh stays all-quad, conforming and consistently oriented.
-/// New points come from Catmull–Clark's masks (see the module docs).
-pub fn split_quads(mesh: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, SubdivError> {
+/// New points come from Catmull–Clark's masks (see the module docs), with the crease rules
+/// on the crease edges `creases` (midpoints; the boundary mask along crease lines).
+pub fn split_quads(
+    mesh: &PolyMesh,
+    marked: &[bool],
+    creases: &[[u32; 2]],
+) -> Result<PolyMesh, SubdivError> {
     let quads = quads_of(mesh)?;
     super::check_flags(marked, quads.len())?;
     check_oriented_edges(mesh)?;
     let edges = QuadEdges::new(&quads, mesh.num_vertices())?;
+    let sharp: HashSet<(u32, u32)> = creases.iter().map(|&[a, b]| (a.min(b), a.max(b))).collect();
+    let is_sharp = |e: usize| {
+        let [a, b] = edges.ends[e];
+        sharp.contains(&(a.min(b), a.max(b)))
+    };
     let split = close_split(&quads, &edges, marked);
     let counts = edges.counts(&split);
     let pos = mesh.positions();
-    let mut positions = moved_vertices(pos, &quads, &edges, &counts);
+    let mut positions = moved_vertices(pos, &quads, &edges, &counts, &is_sharp);
     let centroid = |f: usize| quads[f].iter().map(|&v| pos[v as usize]).sum::<Point3>() * 0.25;
     let mut edge_point = vec![NO; edges.ends.len()];
     for (e, _) in split.iter().enumerate().filter(|(_, &s)| s) {
         let [a, b] = edges.ends[e];
         let mid = pos[a as usize] + pos[b as usize];
         let p = match edges.faces[e] {
-            [f0, f1] if f1 != NO => (mid + centroid(f0 as usize) + centroid(f1 as usize)) * 0.25,
+            [f0, f1] if f1 != NO && !is_sharp(e) => {
+                (mid + centroid(f0 as usize) + centroid(f1 as usize)) * 0.25
+            }
             _ => mid * 0.5,
         };
         edge_point[e] = super::index_u32(positions.len())?;
@@ -336,9 +348,16 @@ fn trace(best: &HashMap<u32, (u64, u32)>, mut s: u32) -> Vec<u32> {
 }
 
 /// Old vertices: those all of whose quads are split 1→4 move by Catmull–Clark's vertex rule
-/// (interior: ((n − 2) V + Σ neighbours / n + Σ face centroids / n) / n; boundary:
-/// (a + 6 V + b) / 8 along the boundary); the others keep their place.
-fn moved_vertices(pos: &[Point3], quads: &[Quad], edges: &QuadEdges, counts: &[u8]) -> Vec<Point3> {
+/// (interior: ((n − 2) V + Σ neighbours / n + Σ face centroids / n) / n; boundary or crease
+/// line: (a + 6 V + b) / 8 along it); the others keep their place, as do corners and dart
+/// ends of the crease edges (`is_sharp`, by edge index).
+fn moved_vertices(
+    pos: &[Point3],
+    quads: &[Quad],
+    edges: &QuadEdges,
+    counts: &[u8],
+    is_sharp: &impl Fn(usize) -> bool,
+) -> Vec<Point3> {
     let n = pos.len();
     let mut all_split = vec![true; n];
     let mut touched = vec![false; n];
@@ -356,7 +375,7 @@ fn moved_vertices(pos: &[Point3], quads: &[Quad], edges: &QuadEdges, counts: &[u
     for (e, &[a, b]) in edges.ends.iter().enumerate() {
         ring[a as usize] += pos[b as usize];
         ring[b as usize] += pos[a as usize];
-        if edges.faces[e][1] == NO {
+        if edges.faces[e][1] == NO || is_sharp(e) {
             rim[a as usize].push(b);
             rim[b as usize].push(a);
         }
@@ -410,7 +429,7 @@ mod tests {
         let g = grid(5);
         let mut marked = vec![false; 25];
         marked[12] = true;
-        let m = split_quads(&g, &marked).expect("split");
+        let m = split_quads(&g, &marked, &[]).expect("split");
         check_oriented_edges(&m).expect("manifold");
         assert!(m.faces().all(|f| f.len() == 4));
         // Planar and every new point inside its old face: the area is kept, nothing flips.
@@ -431,7 +450,7 @@ mod tests {
     #[test]
     fn all_marked_is_one_catmull_clark_step() {
         let g = grid(3);
-        let m = split_quads(&g, &[true; 9]).expect("split");
+        let m = split_quads(&g, &[true; 9], &[]).expect("split");
         assert_eq!(m.num_faces(), 36);
         assert_eq!(m.num_vertices(), 16 + 24 + 9);
         // On a flat grid Catmull–Clark keeps interior points (the inner vertex (1, 1) stays).
@@ -442,7 +461,7 @@ mod tests {
     fn rejects_triangles_and_wrong_flag_count() {
         let t = PolyMesh::try_new(vec![Point3::ZERO, Point3::X, Point3::Y], [[0u32, 1, 2]])
             .expect("triangle");
-        assert!(split_quads(&t, &[true]).is_err());
-        assert!(split_quads(&grid(2), &[true]).is_err());
+        assert!(split_quads(&t, &[true], &[]).is_err());
+        assert!(split_quads(&grid(2), &[true], &[]).is_err());
     }
 }

@@ -9,14 +9,15 @@
 use crate::geom::{Point3, Vec3};
 use crate::mesh::PolyMesh;
 use crate::subdiv::{Scheme, SubdivError};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 /// Where the new points of a split come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SplitRule {
-    /// Loop subdivision masks: edge points 3/8, 3/8, 1/8, 1/8 (midpoints on the boundary), and
-    /// old vertices whose every face is split move by Loop's vertex mask; then the refined
-    /// region has the same limit surface as before.
+    /// Loop subdivision masks: edge points 3/8, 3/8, 1/8, 1/8 (midpoints on the boundary and
+    /// on creases), and old vertices whose every face is split move by Loop's vertex mask (the
+    /// boundary mask along a boundary or crease line; corners stay); then the refined region
+    /// has the same limit surface as before.
     Loop,
     /// Edge midpoints, old vertices kept: exact for piecewise-linear surfaces.
     Midpoint,
@@ -58,12 +59,15 @@ fn edge_faces(tris: &[[u32; 3]]) -> HashMap<Edge, Vec<(usize, u32)>> {
 
 /// Splits the `marked` triangles 1→4 and keeps the mesh conforming: a triangle with two or three
 /// split edges is split 1→4 as well (repeated until stable), one with a single split edge 1→2.
-/// Orientation is kept. `marked` has one flag per face.
+/// Orientation is kept. `marked` has one flag per face; the crease edges `creases` get the
+/// crease rules (see [`SplitRule::Loop`]).
 pub fn split_triangles(
     mesh: &PolyMesh,
     marked: &[bool],
     rule: SplitRule,
+    creases: &[[u32; 2]],
 ) -> Result<PolyMesh, SubdivError> {
+    let sharp: HashSet<Edge> = creases.iter().map(|&[a, b]| edge(a, b)).collect();
     let tris = triangles_of(mesh)?;
     super::check_flags(marked, tris.len())?;
     let faces_on = edge_faces(&tris);
@@ -78,13 +82,13 @@ pub fn split_triangles(
             if mid.contains_key(&e) {
                 continue;
             }
-            let p = edge_point(pos, e, &faces_on[&e], rule);
+            let p = edge_point(pos, e, &faces_on[&e], rule, sharp.contains(&e));
             mid.insert(e, super::index_u32(positions.len())?);
             positions.push(p);
         }
     }
     if rule == SplitRule::Loop {
-        move_old_vertices(pos, &tris, &red, &faces_on, &mut positions);
+        move_old_vertices(pos, &tris, &red, &faces_on, &sharp, &mut positions);
     }
     let mut faces = Vec::with_capacity(tris.len() + 3 * mid.len());
     for (f, &[a, b, c]) in tris.iter().enumerate() {
@@ -140,10 +144,18 @@ fn close_red_set(
     red
 }
 
-fn edge_point(pos: &[Point3], (a, b): Edge, faces: &[(usize, u32)], rule: SplitRule) -> Point3 {
+/// The new point on edge `a`–`b`: Loop's edge mask inside, the midpoint on the boundary and
+/// on a crease (`sharp`), as Loop's crease rules (Hoppe et al. 1994) have it.
+fn edge_point(
+    pos: &[Point3],
+    (a, b): Edge,
+    faces: &[(usize, u32)],
+    rule: SplitRule,
+    sharp: bool,
+) -> Point3 {
     let (pa, pb) = (pos[a as usize], pos[b as usize]);
     match (rule, faces) {
-        (SplitRule::Loop, &[(_, c), (_, d)]) => {
+        (SplitRule::Loop, &[(_, c), (_, d)]) if !sharp => {
             (pa + pb) * 0.375 + (pos[c as usize] + pos[d as usize]) * 0.125
         }
         _ => (pa + pb) * 0.5,
@@ -151,12 +163,14 @@ fn edge_point(pos: &[Point3], (a, b): Edge, faces: &[(usize, u32)], rule: SplitR
 }
 
 /// Loop's vertex mask for old vertices all of whose faces are split (interior: Loop's β;
-/// boundary: 1/8, 3/4, 1/8 along the boundary). Other vertices keep their place.
+/// boundary or crease, two such edges: 1/8, 3/4, 1/8 along them). Other vertices, and corners
+/// and dart ends of the `sharp` edges, keep their place.
 fn move_old_vertices(
     pos: &[Point3],
     tris: &[[u32; 3]],
     red: &[bool],
     faces_on: &HashMap<Edge, Vec<(usize, u32)>>,
+    sharp: &HashSet<Edge>,
     out: &mut [Point3],
 ) {
     let n = pos.len();
@@ -175,7 +189,7 @@ fn move_old_vertices(
     for (&(a, b), faces) in sorted {
         ring[a as usize].push(b);
         ring[b as usize].push(a);
-        if faces.len() == 1 {
+        if faces.len() == 1 || sharp.contains(&(a, b)) {
             boundary[a as usize].push(b);
             boundary[b as usize].push(a);
         }
@@ -199,7 +213,8 @@ fn move_old_vertices(
 /// angle of the pair much worse, or when it removes a thin triangle (smallest angle under 15°)
 /// without raising R(M) by more than 2. Flips need the two triangles to be nearly coplanar (so
 /// the shape is kept), and both new triangles to keep the orientation (no fold-over).
-/// Deterministic: edges are visited in sorted order. Returns the number of flips.
+/// Deterministic: edges are visited in sorted order. Returns the number of flips. The crease
+/// edges `creases` are never flipped (a flip would cut the crease line).
 ///
 /// Only edges next to a vertex numbered `first_new` or higher are considered (an end or an
 /// opposite corner): after a split those are the new midpoints, so the flips stay in the region
@@ -209,12 +224,14 @@ pub fn improve_by_flips(
     mesh: &mut PolyMesh,
     passes: usize,
     first_new: u32,
+    creases: &[[u32; 2]],
 ) -> Result<usize, SubdivError> {
     let mut tris = triangles_of(mesh)?;
     let pos = mesh.positions().to_vec();
+    let fixed: HashSet<Edge> = creases.iter().map(|&[a, b]| edge(a, b)).collect();
     let mut total = 0;
     for _ in 0..passes {
-        let flips = flip_pass(&pos, &mut tris, first_new);
+        let flips = flip_pass(&pos, &mut tris, first_new, &fixed);
         total += flips;
         if flips == 0 {
             break;
@@ -226,7 +243,12 @@ pub fn improve_by_flips(
     Ok(total)
 }
 
-fn flip_pass(pos: &[Point3], tris: &mut [[u32; 3]], first_new: u32) -> usize {
+fn flip_pass(
+    pos: &[Point3],
+    tris: &mut [[u32; 3]],
+    first_new: u32,
+    fixed: &HashSet<Edge>,
+) -> usize {
     let faces_on = edge_faces(tris);
     let mut valence = vec![0i64; pos.len()];
     let mut on_boundary = vec![false; pos.len()];
@@ -247,6 +269,7 @@ fn flip_pass(pos: &[Point3], tris: &mut [[u32; 3]], first_new: u32) -> usize {
             continue;
         };
         if a.max(b).max(c1).max(c2) < first_new
+            || fixed.contains(&(a, b))
             || touched[f1]
             || touched[f2]
             || c1 == c2
@@ -345,7 +368,8 @@ mod tests {
 
     #[test]
     fn red_green_split_is_conforming() {
-        let m = split_triangles(&square(), &[true, false], SplitRule::Midpoint).expect("split");
+        let m =
+            split_triangles(&square(), &[true, false], SplitRule::Midpoint, &[]).expect("split");
         // 1→4 plus the neighbour 1→2, one new point per edge of the red face.
         assert_eq!(m.num_faces(), 6);
         assert_eq!(m.num_vertices(), 7);
@@ -367,8 +391,8 @@ mod tests {
             Point3::new(5.0, -0.3, 0.0),
         ];
         let mut m = PolyMesh::try_new(p, [[0, 1, 2], [1, 0, 3]]).expect("valid");
-        assert_eq!(improve_by_flips(&mut m, 3, 4).expect("none new"), 0);
-        assert_eq!(improve_by_flips(&mut m, 3, 3).expect("flips"), 1);
+        assert_eq!(improve_by_flips(&mut m, 3, 4, &[]).expect("none new"), 0);
+        assert_eq!(improve_by_flips(&mut m, 3, 3, &[]).expect("flips"), 1);
         crate::mesh::check_oriented_edges(&m).expect("manifold");
         assert!(m.faces().all(|f| f.contains(&2) && f.contains(&3)));
     }
