@@ -28,7 +28,8 @@ fn control_mesh_of(
     control: &PolyMesh,
     creases: &[[u32; 2]],
 ) -> Result<ControlMesh, FitError> {
-    let mesh = adaptive::tagged(control, creases)?;
+    let mut mesh = ControlMesh::try_new(control)?;
+    adaptive::tag_creases(&mut mesh, creases);
     Ok(match scheme {
         Scheme::Loop => mesh,
         _ if mesh.is_quad_mesh() => mesh,

@@ -65,17 +65,11 @@ pub fn carried_creases(old: &ControlMesh, refined: &PolyMesh) -> Vec<[u32; 2]> {
     out
 }
 
-/// `mesh` as a control mesh with `creases` tagged sharp (pairs that are no edge, or are
-/// boundary edges, change nothing).
-pub fn tagged(
-    mesh: &PolyMesh,
-    creases: &[[u32; 2]],
-) -> Result<ControlMesh, crate::subdiv::SubdivError> {
-    let mut control = ControlMesh::try_new(mesh)?;
+/// Tags the edges `creases` of `control` sharp; pairs that are no edge, and boundary edges
+/// (sharp already), change nothing.
+pub fn tag_creases(control: &mut ControlMesh, creases: &[[u32; 2]]) {
     for &[a, b] in creases {
-        if control.find_half_edge(a, b).is_some() || control.find_half_edge(b, a).is_some() {
-            control.set_sharp(a, b, true)?;
-        }
+        // `set_sharp` fails only for a pair that is no edge, which this skips.
+        let _ = control.set_sharp(a, b, true);
     }
-    Ok(control)
 }

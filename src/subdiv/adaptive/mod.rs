@@ -14,7 +14,7 @@ mod polygons;
 mod quads;
 mod triangles;
 
-pub use creases::{carried_creases, tagged};
+pub use creases::{carried_creases, tag_creases};
 pub use polygons::split_polygons;
 pub use quads::split_quads;
 pub use triangles::{improve_by_flips, split_triangles, triangles_of, SplitRule};
