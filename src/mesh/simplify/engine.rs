@@ -96,6 +96,9 @@ pub(super) struct Engine {
     turn: Vec<u32>,
     /// How working indices relate to the input's.
     numbering: Numbering,
+    /// Whether ties between equal costs go by a scrambled index rather than the index (see
+    /// [`Engine::scramble_ties`]).
+    scramble_ties: bool,
     /// The crease neighbours of every vertex (the other ends of its crease edges); empty, with
     /// no entry per vertex, when the mesh has no creases (see [`Engine::crease_plan`]).
     crease: Vec<Vec<u32>>,
@@ -153,6 +156,7 @@ impl Engine {
             histogram: Vec::new(),
             turn: Vec::new(),
             numbering,
+            scramble_ties: false,
             crease: Vec::new(),
         };
         e.index_faces();
@@ -181,6 +185,17 @@ impl Engine {
             }
         }
         self.crease = crease;
+    }
+
+    /// Breaks ties between equal costs by a scrambled index from now on, and returns whether
+    /// that is new. Ties by index are the better order while they work (their spatial
+    /// coherence gave fandisk an initial mesh whose fit converged where the scrambled one's
+    /// stalled), but among many equal costs (a flat region, where every collapse costs 0) they
+    /// chain: each vertex's pick is its neighbour's second choice, a wave takes one collapse
+    /// where it could take a matching, and a finely meshed cube stopped at 1,525 of its 1,538
+    /// vertices. So the simplifier scrambles ties only once a pass makes no collapse.
+    pub(super) fn scramble_ties(&mut self) -> bool {
+        !std::mem::replace(&mut self.scramble_ties, true)
     }
 
     /// Number of crease edges.
@@ -500,14 +515,11 @@ impl Engine {
 
     /// Starts a wave: drops the candidates that are out of the pass (refused, or an end
     /// locked) and marks in `cheapest` the cheapest candidate at each vertex, stamped with the
-    /// wave. Ties go to the lower index, except among collapses of cost 0, which go by a
-    /// scrambled index: by the plain index the edges of a flat region would chain, each
-    /// vertex's pick being its neighbour's second choice, and a wave would take one collapse
-    /// where it can take a matching (a finely meshed cube stopped at 1,525 of its 1,538
-    /// vertices). Ties of other costs (symmetric shapes) keep the index order, whose spatial
-    /// coherence simplified a torus 8 % closer than the scrambled one.
+    /// wave. Ties go to the lower index, or by a scrambled index once
+    /// [`Engine::scramble_ties`] is set.
     fn mark_cheapest(&mut self, cands: &mut Vec<Candidate>) {
         self.wave += 1;
+        let scramble_ties = self.scramble_ties;
         let stamp = self.wave << 32;
         let mut kept = 0;
         for i in 0..cands.len() {
@@ -520,8 +532,8 @@ impl Engine {
                 let slot = &mut self.cheapest[end as usize];
                 let cheaper = slot.0 >> 32 != self.wave
                     || slot.1 > c.cost
-                    || (slot.1 == 0.0
-                        && c.cost == 0.0
+                    || (scramble_ties
+                        && slot.1 == c.cost
                         && scramble(kept as u32) < scramble(slot.0 as u32));
                 if cheaper {
                     *slot = (stamp | kept as u64, c.cost);

@@ -415,14 +415,15 @@ fn triangulated(mesh: &PolyMesh) -> std::borrow::Cow<'_, PolyMesh> {
 }
 
 /// Passes of collapses until `target` vertices are left or the loosest of `stages` leaves no
-/// valid collapse; returns the number of passes and the relaxations made.
+/// valid collapse (with ties scrambled: [`Engine::scramble_ties`]); returns the number of
+/// passes and the relaxations made.
 fn reduce(engine: &mut Engine, target: usize, stages: &[Limits]) -> (usize, Vec<Relaxation>) {
     let mut stage = 0;
     let mut passes = 0;
     let mut relaxations = Vec::new();
     while engine.live() > target {
         passes += 1;
-        if engine.pass(target, &stages[stage]) > 0 {
+        if engine.pass(target, &stages[stage]) > 0 || engine.scramble_ties() {
             continue;
         }
         stage += 1;
