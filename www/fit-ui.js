@@ -15,7 +15,7 @@
 import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
 import {
-  CAGE_COLOR, CHART_CONTEXT, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
+  CAGE_COLOR, CHART_CONTEXT, CREASE_COLOR, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
   drawHistogram, edgeSegments, errorColors, fmtPct, fmtUnits, lineSet,
 } from './fit-view.js';
 
@@ -24,6 +24,7 @@ export { drawChart, errorColors } from './fit-view.js';
 // Download name and MIME type of each export.
 const DOWNLOADS = {
   cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
+  creases: ['geofit-cage.creases.json', 'application/json'], usda: ['geofit-cage.usda', 'model/vnd.usda'],
   ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
   glb: ['geofit-surface.glb', 'model/gltf-binary'],
   iges: ['geofit.igs', 'model/iges'], step: ['geofit.stp', 'model/step'],
@@ -207,6 +208,8 @@ class FitPanel {
     const u = this.ui;
     if (limit.indices.length === 0) parts.push([edgeSegments(limit.positions, limit.edges), CURVE_COLOR]);
     if (u.cage.checked) parts.push([edgeSegments(control.positions, control.edges), CAGE_COLOR]);
+    // The cage's crease edges (tagged sharp), over the cage, and shown with the surface too.
+    if (control.creases.length > 0) parts.push([edgeSegments(control.positions, control.creases), CREASE_COLOR]);
     if (u.vectors.checked) parts.push([this.frame.vectors, VECTOR_COLOR]);
     if (u.iso.checked) parts.push([this.frame.iso, ISO_COLOR]);
     if (u.initialMesh.checked) parts.push([edgeSegments(this.once.initial.positions, this.once.initial.edges), INITIAL_COLOR]);

@@ -66,7 +66,7 @@ function postFrame(f, kind) {
     deviation: f.deviations(HISTOGRAM_BINS),
     limit: { positions: limit.positions, normals: limit.normals, indices: limit.indices, edges: limit.edges },
     untrimmed,
-    control: { positions: control.positions, edges: control.edges },
+    control: { positions: control.positions, edges: control.edges, creases: control.creases },
     vectors: f.errorVectors(),
     iso: f.isoLines(resolution),
   };
@@ -76,7 +76,7 @@ function postFrame(f, kind) {
     const initial = f.initialMesh();
     frame.once = {
       data: f.dataPositions(),
-      initial: { positions: initial.positions, edges: initial.edges },
+      initial: { positions: initial.positions, edges: initial.edges, creases: initial.creases },
       notes: f.intakeNotes(),
     };
     initial.free();

@@ -27,9 +27,9 @@
  *   stats: import('../pkg/geofit.js').FitStats, history: import('../pkg/geofit.js').HistoryEntry[], errors: Float32Array,
  *   deviation: import('../pkg/geofit.js').Deviation,
  *   limit: Shape, untrimmed: { normals: Float32Array, indices: Uint32Array } | null,
- *   control: { positions: Float32Array, edges: Uint32Array },
+ *   control: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array },
  *   vectors: Float32Array, iso: Float32Array,
- *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array }, notes: string[] },
+ *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array }, notes: string[] },
  * }} FrameMessage
  *   The state of the fit after a slice (`limit` a B-spline surface cut to the data's outline,
  *   `untrimmed` its whole tessellation over the same positions); `once` (data points, initial control net and what was

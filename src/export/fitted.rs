@@ -13,11 +13,17 @@ use kiddo::SquaredEuclidean;
 
 /// The exports a fit of `scheme` offers: `cage` and `json` always, `obj`/`ply`/`stl`/`glb` for
 /// surfaces, `iges`/`step` for B-splines, `msh` (the FEM quad mesh, [`crate::fem`]) for
-/// B-spline and Catmull–Clark surfaces.
+/// B-spline and Catmull–Clark surfaces, the cage's crease sidecar `creases` for subdivision
+/// surfaces and the USD cage `usda` for Loop and Catmull–Clark ([`super::cage_usda`]).
 pub fn exports_for(scheme: Scheme) -> &'static [&'static str] {
     match scheme {
-        Scheme::Loop | Scheme::DooSabin => &["cage", "obj", "ply", "stl", "glb", "json"],
-        Scheme::CatmullClark => &["cage", "obj", "ply", "stl", "glb", "msh", "json"],
+        Scheme::Loop => &[
+            "cage", "creases", "usda", "obj", "ply", "stl", "glb", "json",
+        ],
+        Scheme::DooSabin => &["cage", "creases", "obj", "ply", "stl", "glb", "json"],
+        Scheme::CatmullClark => &[
+            "cage", "creases", "usda", "obj", "ply", "stl", "glb", "msh", "json",
+        ],
         Scheme::BsplineSurface => &[
             "cage", "obj", "ply", "stl", "glb", "iges", "step", "msh", "json",
         ],

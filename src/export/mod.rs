@@ -7,10 +7,12 @@
 //! equivalent with the closed flag set, which every CAD reader accepts. Coordinates are written
 //! in millimetres, unscaled, with round-trip precision.
 
+mod cage;
 mod fitted;
 pub mod iges;
 pub mod step;
 
+pub use cage::{cage_creases_json, cage_usda, CageCreases, INFINITE_SHARPNESS};
 pub use fitted::{
     cad_model, cage_obj, exports_for, glb_of, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION,
 };

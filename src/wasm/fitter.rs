@@ -198,6 +198,7 @@ pub struct MeshArrays {
     normals: Vec<f32>,
     indices: Vec<u32>,
     edges: Vec<u32>,
+    creases: Vec<u32>,
 }
 
 impl MeshArrays {
@@ -212,6 +213,7 @@ impl MeshArrays {
                     normals: Vec::new(),
                     indices: Vec::new(),
                     edges: (0..segments).flat_map(|i| [i, (i + 1) % n]).collect(),
+                    creases: Vec::new(),
                 }
             }
         }
@@ -234,7 +236,19 @@ impl MeshArrays {
             normals: buffers::vertex_normals(mesh.positions(), &triangles),
             indices: triangles.into_iter().flatten().collect(),
             edges,
+            creases: Vec::new(),
         }
+    }
+
+    /// The control net of `fit` ([`MeshArrays::of`] its control shape) with the crease edges
+    /// of a subdivision cage.
+    fn control_of(fit: &dyn crate::fit::Fitter) -> MeshArrays {
+        let mut arrays = MeshArrays::of(&fit.control_shape());
+        if let Some(surface) = fit.subdiv_surface() {
+            let creases = surface.control_mesh().creases();
+            arrays.creases = creases.into_iter().flat_map(|(a, b)| [a, b]).collect();
+        }
+        arrays
     }
 }
 
@@ -259,6 +273,12 @@ impl MeshArrays {
     #[wasm_bindgen(getter)]
     pub fn edges(&self) -> Vec<u32> {
         self.edges.clone()
+    }
+    /// Two vertex indices per crease edge of a subdivision cage (tagged sharp; empty for other
+    /// shapes and for fits without creases).
+    #[wasm_bindgen(getter)]
+    pub fn creases(&self) -> Vec<u32> {
+        self.creases.clone()
     }
 }
 
@@ -292,7 +312,7 @@ impl Fitter {
     ) -> Result<Fitter, JsError> {
         let spec = spec_from_js(options)?;
         let fit = spec.build(&scan.fit_data())?;
-        let initial = MeshArrays::of(&fit.control_shape());
+        let initial = MeshArrays::control_of(fit.as_ref());
         Ok(Fitter {
             fit,
             initial,
@@ -401,7 +421,7 @@ impl Fitter {
     /// only).
     #[wasm_bindgen(js_name = controlMesh)]
     pub fn control_mesh(&self) -> MeshArrays {
-        MeshArrays::of(&self.fit.control_shape())
+        MeshArrays::control_of(self.fit.as_ref())
     }
 
     /// The control net the fit started from, as `controlMesh()` gives it.
@@ -491,8 +511,10 @@ impl Fitter {
         Ok(export::step_of(self.fit.as_ref(), "geofit")?.into_bytes())
     }
 
-    /// The export named `what` (one of `exportsFor(scheme)`: `cage`, `obj`, `ply`, `stl`, `glb`,
-    /// `iges`, `step`, `json`, `msh`: the FEM quad mesh with the default options) as bytes, as the `export*` method of that name gives it; the
+    /// The export named `what` (one of `exportsFor(scheme)`: `cage`, `creases` (the cage's
+    /// crease sidecar, JSON), `usda` (the cage as USD, with its creases), `obj`, `ply`, `stl`,
+    /// `glb`, `iges`, `step`, `json`, `msh`: the FEM quad mesh with the default options) as
+    /// bytes, as the `export*` method of that name gives it; the
     /// workers export by name through this one table. Throws on another name, or when the
     /// scheme has no such export.
     #[wasm_bindgen(js_name = exportAs)]
@@ -510,8 +532,11 @@ impl Fitter {
             "step" => self.export_step(),
             "json" => Ok(self.report_json()?.into_bytes()),
             "msh" => Ok(self.fem_export(&FemJsOptions::default())?.0),
+            "creases" => Ok(export::cage_creases_json(self.fit.as_ref())?.into_bytes()),
+            "usda" => Ok(export::cage_usda(self.fit.as_ref())?.into_bytes()),
             _ => Err(JsError::new(&format!(
-                "unknown export '{what}': one of cage, obj, ply, stl, glb, iges, step, json, msh"
+                "unknown export '{what}': one of cage, creases, usda, obj, ply, stl, glb, iges, \
+                 step, json, msh"
             ))),
         }
     }

@@ -12,7 +12,7 @@ export type Method = 'geometric' | 'least-squares' | 'knots' | 'sections';
 /** How a fit stands: still iterating, or why it stopped. */
 export type FitStatus = 'running' | 'converged' | 'max_iterations' | 'stalled';
 /** The exports of a fit; `exportsFor(scheme)` says which a scheme offers. */
-export type ExportName = 'cage' | 'json' | 'obj' | 'ply' | 'stl' | 'glb' | 'iges' | 'step' | 'msh';
+export type ExportName = 'cage' | 'creases' | 'usda' | 'json' | 'obj' | 'ply' | 'stl' | 'glb' | 'iges' | 'step' | 'msh';
 /** The file formats `loadFile` reads. */
 export type FileFormat =
   | 'ply' | 'obj' | 'stl' | 'xyz' | 'e57' | 'las' | 'laz' | 'pcd' | 'ptx' | 'gltf' | 'glb';

@@ -141,9 +141,14 @@ pub struct Args {
     /// Write the report (set-up, final errors, times, per-iteration history) as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Write the final control net as OBJ (a curve's polygon as a polyline).
+    /// Write the final control net as OBJ (a curve's polygon as a polyline); a subdivision
+    /// cage with creases gets their sidecar beside it (`NAME.creases.json`).
     #[arg(long)]
     cage: Option<PathBuf>,
+    /// Loop and Catmull–Clark: write the final cage as USD (`.usda`), creases included, for
+    /// OpenSubdiv-based tools.
+    #[arg(long)]
+    usda: Option<PathBuf>,
     /// Write the fitted surface, tessellated, as OBJ.
     #[arg(long)]
     limit: Option<PathBuf>,
@@ -468,7 +473,12 @@ fn write_outputs(
         .unwrap_or("geofit");
     let text = |r: Result<String, export::ExportError>| r.map(String::into_bytes);
     type Make<'a> = Box<dyn Fn() -> Result<Vec<u8>, String> + 'a>;
-    let outputs: [(&Option<PathBuf>, Make); 7] = [
+    let sidecar = args
+        .cage
+        .as_ref()
+        .filter(|_| has_creases(fitter))
+        .map(|p| p.with_extension("creases.json"));
+    let outputs: [(&Option<PathBuf>, Make); 9] = [
         (
             &args.json,
             Box::new(|| json_text(&FitReport::of(fitter), true)),
@@ -476,6 +486,14 @@ fn write_outputs(
         (
             &args.cage,
             Box::new(|| export::cage_obj(fitter).map_err(|e| e.to_string())),
+        ),
+        (
+            &sidecar,
+            Box::new(|| text(export::cage_creases_json(fitter)).map_err(|e| e.to_string())),
+        ),
+        (
+            &args.usda,
+            Box::new(|| text(export::cage_usda(fitter)).map_err(|e| e.to_string())),
         ),
         (
             &args.limit,
@@ -505,6 +523,13 @@ fn write_outputs(
         write_fem(fitter, args, path)?;
     }
     Ok(())
+}
+
+/// Whether the fit's cage has crease edges.
+fn has_creases(fitter: &dyn Fitter) -> bool {
+    fitter
+        .subdiv_surface()
+        .is_some_and(|s| !s.control_mesh().creases().is_empty())
 }
 
 /// The FEM quad mesh of the fitted surface, written as MSH (OBJ for a `.obj` name), and its
