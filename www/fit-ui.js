@@ -124,7 +124,7 @@ class FitPanel {
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
     // deviation: the latest frame's distribution of the errors (the package's `Deviation`).
-    this.figures = { lastStats: null, history: [], deviation: null, surfaceTriangles: 0, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
+    this.figures = { lastStats: null, history: [], creaseEdges: 0, deviation: null, surfaceTriangles: 0, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
     this.tolUnits = [
       linkTolerance(this.ui.tolAvg, this.ui.tolAvgUnits, () => this.diagonal(), () => this.form.edited.add('tolAvg')),
       linkTolerance(this.ui.tolMax, this.ui.tolMaxUnits, () => this.diagonal(), () => this.form.edited.add('tolMax')),
@@ -332,7 +332,7 @@ class FitPanel {
         this.showIntake(m.once.notes);
       }
       this.frame = m;
-      Object.assign(this.figures, { lastStats: m.stats, history: m.history });
+      Object.assign(this.figures, { lastStats: m.stats, history: m.history, creaseEdges: m.control.creases.length / 2 });
       this.figures.frames += 1;
       this.showStats(m.stats);
       this.figures.deviation = m.deviation;

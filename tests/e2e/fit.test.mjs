@@ -514,6 +514,27 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     });
   });
 
+  test('a CAD part keeps its sharp creases: tagged on the cage, drawn, exported as USD', async () => {
+    await onFreshPage('creases', async (fresh) => {
+      const data = join(ROOT, '..', 'shared', 'data');
+      await fresh.setInputFiles('#file', { name: 'fandisk.obj', mimeType: 'model/obj', buffer: readFileSync(join(data, 'fandisk.obj')) });
+      await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+      assert.equal(await fresh.isChecked('#fit-creases'), false, 'off by default');
+      await fresh.check('#fit-creases');
+      await fresh.fill('#fit-max-iter', '6');
+      const stats = await playToEnd(fresh);
+      const edges = await fresh.evaluate(() => window.geofitFit.creaseEdges);
+      console.log(`[e2e] ${backend.name} fandisk with creases: ${edges} crease edges, ${JSON.stringify(stats)}`);
+      assert.ok(edges >= 100, `${edges} crease edges on the cage`);
+      assert.match(await fresh.textContent('#fit-intake'), /sharp features at 40°: 709 crease edges in 34 lines/);
+      const { bytes: usda } = await exportBytes(fresh, 'usda', `${backend.name}-creases`);
+      const text = usda.toString('utf8');
+      assert.ok(text.startsWith('#usda 1.0') && text.includes('subdivisionScheme = "loop"'), text.slice(0, 200));
+      const { bytes: sidecar } = await exportBytes(fresh, 'creases', `${backend.name}-creases`);
+      assert.equal(JSON.parse(sidecar.toString('utf8')).creases.length, edges);
+    });
+  });
+
   test('a stray point is listed, left out of the view and the fit, and the fit converges', async () => {
     await onFreshPage('strays', async (fresh) => {
       assert.equal(await fresh.isHidden('#strays-row'), true, 'the bundled bunny has no strays');
