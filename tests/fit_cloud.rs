@@ -124,7 +124,7 @@ fn a_control_mesh_for_points_needs_no_reconstruction_only_when_given() {
     let data = PolyMesh::from_points(ellipsoid(500)).expect("finite points");
     // Without the reconstruction, simplification alone cannot start from bare points.
     assert!(matches!(
-        geofit::fit::initial_control(&data, Some(50), None),
+        geofit::fit::initial_control(&data, Some(50), None, geofit::subdiv::Scheme::Loop),
         Err(FitError::NoFaces)
     ));
     let two = PolyMesh::from_points(ellipsoid(2)).expect("finite points");

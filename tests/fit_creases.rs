@@ -5,7 +5,7 @@
 mod common;
 
 use common::data_file;
-use geofit::fit::{FitData, FitReport, FitSpec, Scheme, Shape};
+use geofit::fit::{FitData, FitReport, FitSpec, FitStatus, Scheme, Shape};
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::{detect_features, repair, ControlMesh, FeatureOptions, PolyMesh};
 use geofit::subdiv::adaptive::{carried_creases, refine_marked, tag_creases};
@@ -158,6 +158,7 @@ fn fandisk_keeps_its_creases_sharp_through_the_fit() {
     let diagonal = mesh.bbox().expect("bbox").diagonal();
     for scheme in [Scheme::Loop, Scheme::CatmullClark] {
         let mut shares = Vec::new();
+        let mut reports = Vec::new();
         for creases in [true, false] {
             let (report, limit) = fit(&mesh, scheme, creases);
             let ratios = turn_ratios(&mesh, &features.edges, &limit, 3, 0.003 * diagonal);
@@ -182,17 +183,54 @@ fn fandisk_keeps_its_creases_sharp_through_the_fit() {
                 assert!(report.creases.is_none());
             }
             shares.push(sharp);
+            reports.push(report);
         }
-        // The issue asks for every probe; measured at the page defaults: Loop 85.2 % (38.4 %
-        // without creases), Catmull–Clark 98.3 % (54.9 %). The bound is what is reached.
+        // The issue asks for every probe; measured at the page defaults: Loop 97.9 % (38.4 %
+        // without creases), Catmull–Clark 99.2 % (54.9 %). The bound is what is reached.
         assert!(
-            shares[0] >= 0.8,
+            shares[0] >= 0.95,
             "{scheme:?}: {:.3} of the probes sharp",
             shares[0]
         );
         assert!(
-            shares[0] > 1.3 * shares[1],
+            shares[0] > 1.5 * shares[1],
             "{scheme:?}: creases do not sharpen: {shares:?}"
         );
+        // Both converge, two-sided; Loop with less than half the control points (378 against
+        // 815), Catmull–Clark with about as many (1,436 against 1,325: its cage is one
+        // Catmull–Clark step of the QEM mesh, whose lines cost it more).
+        assert!(
+            reports.iter().all(|r| r.status == FitStatus::Converged),
+            "{scheme:?}"
+        );
+        let (with, without) = (
+            reports[0].final_control_points,
+            reports[1].final_control_points,
+        );
+        let bound = if scheme == Scheme::Loop { 0.5 } else { 1.15 };
+        assert!(
+            with as f64 <= bound * without as f64,
+            "{scheme:?}: {with} control points with creases, {without} without"
+        );
     }
+}
+
+#[test]
+fn rocker_arm_converges_with_fewer_control_points_when_its_creases_are_kept() {
+    let file = geofit::io::read_path(&data_file("rocker-arm.obj")).expect("rocker-arm.obj");
+    let mesh = repair(&file.mesh).expect("repair").mesh;
+    let (with, _) = fit(&mesh, Scheme::Loop, true);
+    let (without, _) = fit(&mesh, Scheme::Loop, false);
+    println!(
+        "rocker-arm Loop: {} -> {} ctrl {:?} with creases, {} -> {} ctrl {:?} without",
+        with.initial_control_points,
+        with.final_control_points,
+        with.status,
+        without.initial_control_points,
+        without.final_control_points,
+        without.status
+    );
+    // Measured: 319 -> 368 converged with creases, 200 -> 803 converged without.
+    assert_eq!(with.status, FitStatus::Converged);
+    assert!(with.final_control_points * 2 <= without.final_control_points);
 }

@@ -89,7 +89,8 @@ pub enum FitError {
     /// use geofit::geom::Point3;
     /// use geofit::mesh::PolyMesh;
     /// let cloud = PolyMesh::try_new(vec![Point3::ZERO; 3], Vec::<[u32; 3]>::new()).unwrap();
-    /// assert_eq!(initial_control(&cloud, None, None), Err(FitError::NoFaces));
+    /// let loop_scheme = geofit::subdiv::Scheme::Loop;
+    /// assert_eq!(initial_control(&cloud, None, None, loop_scheme), Err(FitError::NoFaces));
     /// ```
     #[error("invalid control mesh: the data has no faces; reconstruct a mesh from the points or give a control mesh")]
     NoFaces,

@@ -26,18 +26,21 @@ pub fn default_initial_count(n: usize, used: usize) -> usize {
 
 /// The data mesh repaired and simplified by QEM to `target` vertices (or
 /// [`default_initial_count`]), with the report of both; with `features`, the data's creases
-/// are detected first and kept by QEM as chains of edges ([`Simplified::creases`]), and the
-/// second value says what was found. A point cloud has no faces to simplify: reconstruct a
+/// are detected first and kept by QEM as chains of edges ([`Simplified::creases`]), the
+/// default count grows by the vertices the lines keep, and the second value says what was
+/// found. A point cloud has no faces to simplify: reconstruct a
 /// mesh first (as [`build_subdiv_fitter`] does).
 pub fn initial_control(
     data: &PolyMesh,
     target: Option<usize>,
     features: Option<&FeatureOptions>,
+    scheme: Scheme,
 ) -> Result<(Simplified, Option<CreaseReport>), FitError> {
     if data.is_point_cloud() {
         return Err(FitError::NoFaces);
     }
     let used = used_vertices(data);
+    let given = target;
     let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
     // Detection fails only on options FitSpec has validated already.
     let found = features
@@ -48,7 +51,23 @@ pub fn initial_control(
             reason: e.to_string(),
         })?;
     let edges = found.as_ref().map_or(&[][..], |(_, f)| f.edges.as_slice());
-    let simplified = simplify_with_creases(data, target, &SimplifyOptions::default(), edges)?;
+    let options = SimplifyOptions::default();
+    let mut simplified = simplify_with_creases(data, target, &options, edges)?;
+    // The default count is for the smooth surface: crease lines take their vertices on top of
+    // it. Out of fandisk's default 200, 170 sat on its lines, and the faces between them had
+    // too few of their own to follow the part (its thin blade became a pillow with sheets
+    // 1.7 % of the diagonal off the data). The quad schemes' cage is one Catmull–Clark step
+    // of this mesh, six times the vertices, which follows the faces with a quarter of the
+    // addition (see docs/features.md).
+    let on_lines = crease_vertices(&simplified.creases);
+    if given.is_none() && on_lines > 0 {
+        let extra = match scheme {
+            Scheme::Loop => on_lines,
+            Scheme::CatmullClark | Scheme::DooSabin => on_lines.div_ceil(4),
+        };
+        let more = (target + extra).min(used);
+        simplified = simplify_with_creases(data, more, &options, edges)?;
+    }
     let report = found.map(|(angle_deg, f)| CreaseReport {
         angle_deg,
         summary: f.summary(),
@@ -60,6 +79,14 @@ pub fn initial_control(
         control_edges: simplified.creases.len(),
     });
     Ok((simplified, report))
+}
+
+/// Vertices of the crease edges `creases`.
+fn crease_vertices(creases: &[[u32; 2]]) -> usize {
+    let mut ends: Vec<u32> = creases.iter().flatten().copied().collect();
+    ends.sort_unstable();
+    ends.dedup();
+    ends.len()
 }
 
 /// The sharp features found on the data and kept on the initial control mesh: goes into the
@@ -135,7 +162,7 @@ pub(crate) fn build_subdiv_fitter(
         let points = std::borrow::Cow::Borrowed(data.positions());
         (points, std::borrow::Cow::Borrowed(data), None)
     };
-    let start = control_mesh(&mesh, control, initial, features)?;
+    let start = control_mesh(&mesh, control, initial, features, scheme)?;
     let mut fitter =
         SubdivFitter::with_creases(&points, start.mesh, &start.creases, scheme, options)?
             .with_reference(DataSurface::of_mesh(&mesh));
@@ -159,6 +186,7 @@ fn control_mesh(
     given: Option<&PolyMesh>,
     initial: Option<usize>,
     features: Option<&FeatureOptions>,
+    scheme: Scheme,
 ) -> Result<Start, FitError> {
     if let Some(control) = given {
         return Ok(Start {
@@ -168,7 +196,7 @@ fn control_mesh(
             crease_report: None,
         });
     }
-    let (simplified, crease_report) = initial_control(mesh, initial, features)?;
+    let (simplified, crease_report) = initial_control(mesh, initial, features, scheme)?;
     Ok(Start {
         mesh: simplified.mesh,
         creases: simplified.creases,
