@@ -153,3 +153,38 @@ fn fandisk_keeps_its_crease_lines_through_qem() {
         }
     }
 }
+
+#[test]
+fn the_command_line_keeps_creases_on_request() {
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
+            .args([
+                "simplify",
+                data_file("fandisk.obj").to_str().expect("utf-8 path"),
+            ])
+            .args(["--target", "300", "--json"])
+            .args(extra)
+            .output()
+            .expect("geofit runs");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("json");
+        (
+            report["creases"]["input"].as_u64(),
+            report["creases"]["output"].as_u64(),
+        )
+    };
+    assert_eq!(run(&[]), (Some(0), Some(0)));
+    let (input, output) = run(&["--creases"]);
+    assert_eq!(input, Some(709), "fandisk's detected crease edges");
+    assert!(
+        output.is_some_and(|n| n >= 150),
+        "{output:?} crease edges kept"
+    );
+    // A sharper angle finds fewer.
+    let (sharper, _) = run(&["--creases", "--crease-angle", "80"]);
+    assert!(sharper < input, "{sharper:?}");
+}

@@ -1,11 +1,13 @@
-//! `geofit simplify FILE --target N [-o OUT.obj] [--json]`: QEM simplification (with the repair
+//! `geofit simplify FILE --target N [--creases] [-o OUT.obj] [--json]`: QEM simplification (with the repair
 //! it starts with), timed, with the distance of the input's points to the result; and
 //! `geofit simplify FILE --measure OTHER`: the same measures for a mesh made elsewhere, so that
 //! other simplifiers are judged exactly as geofit is.
 
 use crate::output::{print_json, read_input};
+use geofit::mesh::{
+    detect_features, simplify_with_creases, FeatureOptions, PolyMesh, SimplifyOptions,
+};
 use geofit::mesh::{deviation, foldovers};
-use geofit::mesh::{simplify_with_report, PolyMesh, SimplifyOptions};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -36,6 +38,13 @@ pub struct Args {
     /// Largest valence a collapse may create (default 16).
     #[arg(long)]
     max_valence: Option<usize>,
+    /// Find the mesh's sharp creases first and keep them as edge chains (the result's crease
+    /// edges are counted in `creases`).
+    #[arg(long)]
+    creases: bool,
+    /// With --creases: dihedral angle above which an edge is a crease, degrees (default 40).
+    #[arg(long)]
+    crease_angle: Option<f64>,
     /// Print one JSON object on one line instead of indented JSON.
     #[arg(long)]
     json: bool,
@@ -54,8 +63,23 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     let target = args.target.unwrap_or_default();
     let options = options(&args);
+    let features = FeatureOptions {
+        angle_deg: args
+            .crease_angle
+            .unwrap_or(FeatureOptions::DEFAULT_ANGLE_DEG),
+        ..FeatureOptions::default()
+    };
+    let creases = match args.creases {
+        true => {
+            detect_features(mesh, &features)
+                .map_err(|e| e.to_string())?
+                .edges
+        }
+        false => Vec::new(),
+    };
     let (cpu, start) = (thread_cpu_seconds(), Instant::now());
-    let done = simplify_with_report(mesh, target, &options).map_err(|e| e.to_string())?;
+    let done =
+        simplify_with_creases(mesh, target, &options, &creases).map_err(|e| e.to_string())?;
     let seconds = start.elapsed().as_secs_f64();
     let cpu_seconds = thread_cpu_seconds().zip(cpu).map(|(b, a)| b - a);
     if let Some(path) = &args.output {
@@ -72,6 +96,7 @@ pub fn run(args: Args) -> Result<(), String> {
         "floor_note": r.floor_note,
         "max_valence": r.max_valence,
         "repairs": r.repair,
+        "creases": r.creases,
     });
     if let (Some(map), serde_json::Value::Object(more)) = (report.as_object_mut(), extra) {
         map.extend(more);
