@@ -234,3 +234,33 @@ fn rocker_arm_converges_with_fewer_control_points_when_its_creases_are_kept() {
     assert_eq!(with.status, FitStatus::Converged);
     assert!(with.final_control_points * 2 <= without.final_control_points);
 }
+
+#[test]
+fn crease_curves_run_along_the_tagged_edges() {
+    // A cube with its 12 edges tagged: every corner has three crease edges, so each edge's
+    // limit curve is the straight edge between its two corners, for Loop and Catmull–Clark.
+    for (scheme, mesh) in [
+        (
+            Subdiv::Loop,
+            common::meshes::refine_flat(&common::meshes::cube(), 1),
+        ),
+        (Subdiv::CatmullClark, common::meshes::cube()),
+    ] {
+        let features = detect_features(&mesh, &FeatureOptions::default()).expect("features");
+        let mut control = ControlMesh::try_new(&mesh).expect("control mesh");
+        tag_creases(&mut control, &features.edges);
+        let surface = geofit::subdiv::SubdivSurface::try_new(scheme, control).expect("surface");
+        let curves = surface.crease_curves(8);
+        assert_eq!(curves.len(), 2 * 8 * features.edges.len(), "{scheme:?}");
+        let on_edge = |p: Point3| {
+            let at_face = |x: f64| x.abs() < 1e-9 || (x - 1.0).abs() < 1e-9;
+            [p.x, p.y, p.z].into_iter().filter(|&x| at_face(x)).count() >= 2
+        };
+        assert!(
+            curves.iter().all(|&p| on_edge(p)),
+            "{scheme:?}: a crease curve leaves its edge"
+        );
+        let length: f64 = curves.chunks(2).map(|s| s[0].distance(s[1])).sum();
+        assert!((length - 12.0).abs() < 1e-9, "{scheme:?}: length {length}");
+    }
+}

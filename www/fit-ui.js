@@ -15,7 +15,7 @@
 import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
 import {
-  CAGE_COLOR, CHART_CONTEXT, CREASE_COLOR, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
+  CAGE_COLOR, CHART_CONTEXT, CREASE_COLOR, DATA_CREASE_COLOR, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
   drawHistogram, edgeSegments, errorColors, fmtPct, fmtUnits, lineSet,
 } from './fit-view.js';
 
@@ -208,8 +208,11 @@ class FitPanel {
     const u = this.ui;
     if (limit.indices.length === 0) parts.push([edgeSegments(limit.positions, limit.edges), CURVE_COLOR]);
     if (u.cage.checked) parts.push([edgeSegments(control.positions, control.edges), CAGE_COLOR]);
-    // The cage's crease edges (tagged sharp), over the cage, and shown with the surface too.
-    if (control.creases.length > 0) parts.push([edgeSegments(control.positions, control.creases), CREASE_COLOR]);
+    // With creases on: the cage's crease edges when the cage is shown, their limit curves on the
+    // surface, and the lines found on the data.
+    if (u.cage.checked && control.creases.length > 0) parts.push([edgeSegments(control.positions, control.creases), CREASE_COLOR]);
+    if (this.frame.creaseCurves.length > 0) parts.push([this.frame.creaseCurves, CREASE_COLOR]);
+    if (this.once.dataCreases.length > 0) parts.push([this.once.dataCreases, DATA_CREASE_COLOR]);
     if (u.vectors.checked) parts.push([this.frame.vectors, VECTOR_COLOR]);
     if (u.iso.checked) parts.push([this.frame.iso, ISO_COLOR]);
     if (u.initialMesh.checked) parts.push([edgeSegments(this.once.initial.positions, this.once.initial.edges), INITIAL_COLOR]);
@@ -332,7 +335,7 @@ class FitPanel {
         this.showIntake(m.once.notes);
       }
       this.frame = m;
-      Object.assign(this.figures, { lastStats: m.stats, history: m.history, creaseEdges: m.control.creases.length / 2 });
+      Object.assign(this.figures, { lastStats: m.stats, history: m.history, creaseEdges: m.control.creases.length / 2, creaseCurveSegments: m.creaseCurves.length / 6, dataCreaseSegments: this.once.dataCreases.length / 6 });
       this.figures.frames += 1;
       this.showStats(m.stats);
       this.figures.deviation = m.deviation;

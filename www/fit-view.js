@@ -11,6 +11,7 @@ const OUTSIDE_POS = [0.9, 0.08, 0.05];
 export const VECTOR_COLOR = [1.0, 0.85, 0.2];
 export const CAGE_COLOR = [0.35, 0.95, 0.55];
 export const CREASE_COLOR = [1.0, 0.3, 0.35];
+export const DATA_CREASE_COLOR = [1.0, 0.4, 0.95];
 export const ISO_COLOR = [0.3, 0.85, 1.0];
 export const INITIAL_COLOR = [0.75, 0.55, 1.0];
 export const CURVE_COLOR = [1.0, 0.55, 0.1];

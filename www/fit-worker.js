@@ -69,6 +69,7 @@ function postFrame(f, kind) {
     control: { positions: control.positions, edges: control.edges, creases: control.creases },
     vectors: f.errorVectors(),
     iso: f.isoLines(resolution),
+    creaseCurves: f.creaseCurves(resolution),
   };
   limit.free();
   control.free();
@@ -77,6 +78,7 @@ function postFrame(f, kind) {
     frame.once = {
       data: f.dataPositions(),
       initial: { positions: initial.positions, edges: initial.edges, creases: initial.creases },
+      dataCreases: f.dataCreases(),
       notes: f.intakeNotes(),
     };
     initial.free();

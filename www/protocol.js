@@ -28,8 +28,8 @@
  *   deviation: import('../pkg/geofit.js').Deviation,
  *   limit: Shape, untrimmed: { normals: Float32Array, indices: Uint32Array } | null,
  *   control: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array },
- *   vectors: Float32Array, iso: Float32Array,
- *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array }, notes: string[] },
+ *   vectors: Float32Array, iso: Float32Array, creaseCurves: Float32Array,
+ *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array }, dataCreases: Float32Array, notes: string[] },
  * }} FrameMessage
  *   The state of the fit after a slice (`limit` a B-spline surface cut to the data's outline,
  *   `untrimmed` its whole tessellation over the same positions); `once` (data points, initial control net and what was

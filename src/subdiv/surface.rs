@@ -283,6 +283,36 @@ impl SubdivSurface {
         &self.mesh
     }
 
+    /// The limit curves of the crease edges as line segments (both ends of each, `segments`
+    /// per crease edge): where the surface is sharp, for drawing. Loop and Catmull–Clark
+    /// patches are the control faces, so a crease edge's curve is a side of the patch of
+    /// either face on it; Doo–Sabin patches sit elsewhere, and it draws none.
+    pub fn crease_curves(&self, segments: usize) -> Vec<Point3> {
+        if self.scheme == Scheme::DooSabin {
+            return Vec::new();
+        }
+        let segments = segments.max(1);
+        let domain = self.domain();
+        let mut out = Vec::new();
+        for (a, b) in self.mesh.creases() {
+            let Some(h) = self.mesh.find_half_edge(a, b) else {
+                continue;
+            };
+            let f = self.mesh.face_of(h);
+            let Some(k) = self.mesh.face_half_edges(f).position(|x| x == h) else {
+                continue;
+            };
+            let at = |i: usize| {
+                let (u, v) = side_param(domain, k, i as f64 / segments as f64);
+                self.eval(SurfaceParam { patch: f, u, v }).point
+            };
+            for i in 0..segments {
+                out.extend([at(i), at(i + 1)]);
+            }
+        }
+        out
+    }
+
     /// Exact limit positions of the control vertices (limit masks).
     pub fn limit_positions(&self) -> Vec<Point3> {
         let p = self.mesh.positions();
@@ -436,5 +466,18 @@ impl LimitSurface for SubdivSurface {
             Some(ds) => super::walk::walk_doo_sabin(ds, patch, u, v),
             None => super::walk::relocate(&self.mesh, self.scheme, patch, u, v),
         }
+    }
+}
+
+/// The parameters of the point a fraction `t` along side `k` of a Loop or Catmull–Clark patch
+/// (side `k` runs from corner `k` to corner `k + 1` of its face, as the face's half-edges do).
+pub fn side_param(domain: PatchDomain, k: usize, t: f64) -> (f64, f64) {
+    match (domain, k) {
+        (_, 0) => (t, 0.0),
+        (PatchDomain::Triangle, 1) => (1.0 - t, t),
+        (PatchDomain::Triangle, _) => (0.0, 1.0 - t),
+        (PatchDomain::Square, 1) => (1.0, t),
+        (PatchDomain::Square, 2) => (1.0 - t, 1.0),
+        (PatchDomain::Square, _) => (0.0, 1.0 - t),
     }
 }

@@ -450,6 +450,26 @@ impl Fitter {
         buffers::to_f32_xyz(&self.fit.iso_lines(resolution))
     }
 
+    /// The limit curves of the cage's crease edges as line segments (`x, y, z` of both ends,
+    /// `resolution` segments per crease edge); empty without creases, and for Doo–Sabin.
+    #[wasm_bindgen(js_name = creaseCurves)]
+    pub fn crease_curves(&self, resolution: usize) -> Vec<f32> {
+        let curves = self
+            .fit
+            .subdiv_surface()
+            .map(|s| s.crease_curves(resolution.clamp(1, 64)))
+            .unwrap_or_default();
+        buffers::to_f32_xyz(&curves)
+    }
+
+    /// The crease edges found on the data (`creases` on) as line segments, `x, y, z` of both
+    /// ends; empty when crease detection was off or found none.
+    #[wasm_bindgen(js_name = dataCreases)]
+    pub fn data_creases(&self) -> Vec<f32> {
+        let log = self.fit.state().log();
+        buffers::to_f32_xyz(log.creases().map_or(&[][..], |c| &c.segments))
+    }
+
     /// Error vectors as line segments: data point, then its foot point, `x, y, z` each.
     #[wasm_bindgen(js_name = errorVectors)]
     pub fn error_vectors(&self) -> Vec<f32> {

@@ -3,7 +3,7 @@
 
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::PolyMesh;
-use geofit::subdiv::{LimitEval, LimitSurface, PatchDomain, SubdivSurface, SurfaceParam};
+use geofit::subdiv::{side_param, LimitEval, LimitSurface, SubdivSurface, SurfaceParam};
 
 /// `a` and `b` agree to `tol`, relative to their size (absolute near the origin).
 pub fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
@@ -13,18 +13,6 @@ pub fn close(a: Vec3, b: Vec3, tol: f64) -> bool {
 /// The unit normal S_u × S_v of an evaluation.
 pub fn normal(e: &LimitEval) -> Vec3 {
     e.du.cross(e.dv).normalize()
-}
-
-/// Parameters at fraction `a` along side `k` of a patch domain, from corner k to corner k + 1.
-pub fn side_param(domain: PatchDomain, k: usize, a: f64) -> (f64, f64) {
-    match (domain, k) {
-        (_, 0) => (a, 0.0),
-        (PatchDomain::Triangle, 1) => (1.0 - a, a),
-        (PatchDomain::Triangle, _) => (0.0, 1.0 - a),
-        (PatchDomain::Square, 1) => (1.0, a),
-        (PatchDomain::Square, 2) => (1.0 - a, 1.0),
-        (PatchDomain::Square, _) => (0.0, 1.0 - a),
-    }
 }
 
 /// Positions and tangent planes of the patches on both sides of every interior control edge

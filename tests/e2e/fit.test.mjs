@@ -526,6 +526,9 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       const edges = await fresh.evaluate(() => window.geofitFit.creaseEdges);
       console.log(`[e2e] ${backend.name} fandisk with creases: ${edges} crease edges, ${JSON.stringify(stats)}`);
       assert.ok(edges >= 100, `${edges} crease edges on the cage`);
+      const { creaseCurveSegments, dataCreaseSegments } = await fresh.evaluate(() => window.geofitFit);
+      assert.ok(creaseCurveSegments >= edges, `${creaseCurveSegments} segments of crease curves drawn on the surface`);
+      assert.equal(dataCreaseSegments, 709, 'the crease edges found on the data are drawn');
       assert.match(await fresh.textContent('#fit-intake'), /sharp features at 40°: 709 crease edges in 34 lines/);
       const { bytes: usda } = await exportBytes(fresh, 'usda', `${backend.name}-creases`);
       const text = usda.toString('utf8');

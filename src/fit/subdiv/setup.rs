@@ -69,6 +69,11 @@ pub fn initial_control(
         simplified = simplify_with_creases(data, more, &options, edges)?;
     }
     let report = found.map(|(angle_deg, f)| CreaseReport {
+        segments: f
+            .edges
+            .iter()
+            .flat_map(|e| e.map(|v| data.positions()[v as usize]))
+            .collect(),
         angle_deg,
         summary: f.summary(),
         edges: f.edges.len(),
@@ -109,6 +114,10 @@ pub struct CreaseReport {
     pub length: f64,
     /// Crease edges tagged sharp on the initial control mesh.
     pub control_edges: usize,
+    /// The crease edges of the data as line segments (both ends of each), for drawing; not
+    /// written to JSON.
+    #[serde(skip)]
+    pub segments: Vec<Point3>,
 }
 
 /// What [`build_subdiv_fitter`] made of bare points before simplifying: goes into the fit
