@@ -156,6 +156,21 @@ export interface SimplifyReport {
   floor_note: string | null;
   max_valence: number;
   repair: RepairReport;
+  /** Crease edges given to QEM (found on the data, `creases` on) and kept on the result. */
+  creases: { input: number; output: number };
+}
+
+/** The sharp features found on the data and kept sharp on the initial control mesh
+ * (`creases` on). */
+export interface CreaseReport {
+  angle_deg: number;
+  summary: string;
+  edges: number;
+  lines: number;
+  corners: number;
+  darts: number;
+  length: number;
+  control_edges: number;
 }
 
 /** What was reconstructed from bare points. */
@@ -225,6 +240,7 @@ export interface FitReportCommon {
   deviation: DeviationReport;
   reconstruction?: ReconstructionReport;
   simplification?: SimplifyReport;
+  creases?: CreaseReport;
   strays?: { indices: number[] };
   intake: string[];
   precompute_s: number;

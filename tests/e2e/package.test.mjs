@@ -169,7 +169,7 @@ describe('the npm package', () => {
         assert.equal(badFile[0], true);
         assert.match(badFile[1], /ply/i);
         const badExport = await page.evaluate(() => window.geofit.error(null, 'bunny-section.xyz', { scheme: 'bspline-curve' }, ['dwg']));
-        assert.deepEqual(badExport, [true, "unknown export 'dwg': one of cage, obj, ply, stl, glb, iges, step, json, msh"]);
+        assert.deepEqual(badExport, [true, "unknown export 'dwg': one of cage, creases, usda, obj, ply, stl, glb, iges, step, json, msh"]);
 
         if (bundle === 'dist-esbuild') {
           const curve = await page.evaluate(() => window.geofit.fit('bunny-section.xyz', { scheme: 'bspline-curve', method: 'knots' }, []));
