@@ -72,8 +72,7 @@ fn refinement_splits_crease_edges_into_crease_edges_and_keeps_corners() {
 }
 
 /// The unit normal of the limit tessellation's triangle nearest to `p` (by centroid).
-fn normal_near(limit: &PolyMesh, centroids: &[(Point3, Vec3)], p: Point3) -> Vec3 {
-    let _ = limit;
+fn normal_near(centroids: &[(Point3, Vec3)], p: Point3) -> Vec3 {
     centroids
         .iter()
         .min_by(|a, b| a.0.distance_squared(p).total_cmp(&b.0.distance_squared(p)))
@@ -130,10 +129,7 @@ fn turn_ratios(
                 mid + (d - along * d.dot(along)).normalize_or_zero() * reach
             };
             let (pf, pg) = (into(f), into(g));
-            let (nf, ng) = (
-                normal_near(limit, &centroids, pf),
-                normal_near(limit, &centroids, pg),
-            );
+            let (nf, ng) = (normal_near(&centroids, pf), normal_near(&centroids, pg));
             let turn = nf.dot(ng).clamp(-1.0, 1.0).acos();
             Some(turn / data_turn)
         })
