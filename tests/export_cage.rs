@@ -35,10 +35,10 @@ fn ints(text: &str, name: &str) -> Vec<u32> {
         .collect()
 }
 
-fn edges_of(mesh: &PolyMesh) -> HashSet<(u32, u32)> {
+fn edges_of(mesh: &PolyMesh) -> HashSet<[u32; 2]> {
     mesh.faces()
         .flat_map(|f| (0..f.len()).map(move |k| (f[k], f[(k + 1) % f.len()])))
-        .map(|(a, b)| (a.min(b), a.max(b)))
+        .map(|(a, b)| [a.min(b), a.max(b)])
         .collect()
 }
 
@@ -76,7 +76,7 @@ fn the_usd_cage_carries_the_creases_of_the_fit() {
         assert_eq!(ends.len(), 2 * creases.len());
         assert!(lengths.iter().all(|&l| l == 2) && lengths.len() == creases.len());
         let edges = edges_of(&cage);
-        let written: Vec<(u32, u32)> = ends.chunks(2).map(|p| (p[0], p[1])).collect();
+        let written: Vec<[u32; 2]> = ends.chunks(2).map(|p| [p[0], p[1]]).collect();
         assert_eq!(written, creases);
         assert!(written.iter().all(|e| edges.contains(e)));
         let sharp = text

@@ -5,6 +5,7 @@
 mod common;
 
 use common::data_file;
+use common::meshes::{crease_degrees, cube, on_unit_cube_edge, refine_flat};
 use geofit::fit::{FitData, FitReport, FitSpec, FitStatus, Scheme, Shape};
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::{detect_features, repair, ControlMesh, FeatureOptions, PolyMesh};
@@ -12,26 +13,18 @@ use geofit::subdiv::adaptive::{carried_creases, refine_marked, tag_creases};
 use geofit::subdiv::Scheme as Subdiv;
 use std::collections::HashMap;
 
-/// Crease degree of every vertex of `edges`.
-fn degrees(edges: &[[u32; 2]]) -> HashMap<u32, usize> {
-    let mut d = HashMap::new();
-    for e in edges {
-        for v in e {
-            *d.entry(*v).or_insert(0) += 1;
-        }
-    }
-    d
+/// Unit cubes for the tagged-refinement tests: finely triangulated for Loop, six quads for
+/// Catmull–Clark.
+fn cubes() -> [(Subdiv, PolyMesh); 2] {
+    [
+        (Subdiv::Loop, refine_flat(&cube(), 1)),
+        (Subdiv::CatmullClark, cube()),
+    ]
 }
 
 #[test]
 fn refinement_splits_crease_edges_into_crease_edges_and_keeps_corners() {
-    for (scheme, mesh) in [
-        (
-            Subdiv::Loop,
-            common::meshes::refine_flat(&common::meshes::cube(), 1),
-        ),
-        (Subdiv::CatmullClark, common::meshes::cube()),
-    ] {
+    for (scheme, mesh) in cubes() {
         let features = detect_features(&mesh, &FeatureOptions::default()).expect("features");
         let corners: Vec<u32> = features.corners.clone();
         assert_eq!(corners.len(), 8, "{scheme:?}");
@@ -58,7 +51,7 @@ fn refinement_splits_crease_edges_into_crease_edges_and_keeps_corners() {
             "{scheme:?}: {before} -> {}",
             carried.len()
         );
-        let d = degrees(&carried);
+        let d = crease_degrees(&carried);
         for &c in &corners {
             assert_eq!(d.get(&c), Some(&3), "{scheme:?}: corner {c}");
             assert_eq!(pos[c as usize], mesh.positions()[c as usize], "{scheme:?}");
@@ -235,25 +228,15 @@ fn rocker_arm_converges_with_fewer_control_points_when_its_creases_are_kept() {
 fn crease_curves_run_along_the_tagged_edges() {
     // A cube with its 12 edges tagged: every corner has three crease edges, so each edge's
     // limit curve is the straight edge between its two corners, for Loop and Catmull–Clark.
-    for (scheme, mesh) in [
-        (
-            Subdiv::Loop,
-            common::meshes::refine_flat(&common::meshes::cube(), 1),
-        ),
-        (Subdiv::CatmullClark, common::meshes::cube()),
-    ] {
+    for (scheme, mesh) in cubes() {
         let features = detect_features(&mesh, &FeatureOptions::default()).expect("features");
         let mut control = ControlMesh::try_new(&mesh).expect("control mesh");
         tag_creases(&mut control, &features.edges);
         let surface = geofit::subdiv::SubdivSurface::try_new(scheme, control).expect("surface");
         let curves = surface.crease_curves(8);
         assert_eq!(curves.len(), 2 * 8 * features.edges.len(), "{scheme:?}");
-        let on_edge = |p: Point3| {
-            let at_face = |x: f64| x.abs() < 1e-9 || (x - 1.0).abs() < 1e-9;
-            [p.x, p.y, p.z].into_iter().filter(|&x| at_face(x)).count() >= 2
-        };
         assert!(
-            curves.iter().all(|&p| on_edge(p)),
+            curves.iter().all(|&p| on_unit_cube_edge(p, 1e-9)),
             "{scheme:?}: a crease curve leaves its edge"
         );
         let length: f64 = curves.chunks(2).map(|s| s[0].distance(s[1])).sum();

@@ -6,35 +6,18 @@ mod common;
 
 use common::data_file;
 use common::manifold::assert_manifold;
+use common::meshes::{crease_degrees, on_unit_cube_edge};
 use geofit::geom::Point3;
 use geofit::mesh::{
     detect_features, repair, simplify_with_creases, simplify_with_report, FeatureOptions, PolyMesh,
     Simplified, SimplifyOptions,
 };
-use std::collections::HashMap;
 
 fn simplify_keeping_features(mesh: &PolyMesh, target: usize) -> (Simplified, usize) {
     let features = detect_features(mesh, &FeatureOptions::default()).expect("features");
     let done = simplify_with_creases(mesh, target, &SimplifyOptions::default(), &features.edges)
         .expect("simplify");
     (done, features.edges.len())
-}
-
-/// How many crease edges each vertex of `edges` has.
-fn crease_degrees(edges: &[[u32; 2]]) -> HashMap<u32, usize> {
-    let mut degree = HashMap::new();
-    for e in edges {
-        for v in e {
-            *degree.entry(*v).or_insert(0) += 1;
-        }
-    }
-    degree
-}
-
-/// Whether `p` lies on an edge of the unit cube (two coordinates at 0 or 1).
-fn on_cube_edge(p: Point3) -> bool {
-    let at_face = |x: f64| x.abs() < 1e-12 || (x - 1.0).abs() < 1e-12;
-    [p.x, p.y, p.z].into_iter().filter(|&x| at_face(x)).count() >= 2
 }
 
 #[test]
@@ -57,7 +40,10 @@ fn a_fine_cube_keeps_its_edges_and_corners() {
     let pos = out.positions();
     for &[a, b] in &done.creases {
         let (pa, pb) = (pos[a as usize], pos[b as usize]);
-        assert!(on_cube_edge(pa) && on_cube_edge(pb), "{pa:?}-{pb:?}");
+        assert!(
+            on_unit_cube_edge(pa, 1e-12) && on_unit_cube_edge(pb, 1e-12),
+            "{pa:?}-{pb:?}"
+        );
         let same = [pa.x == pb.x, pa.y == pb.y, pa.z == pb.z];
         assert_eq!(same.iter().filter(|&&s| s).count(), 2, "{pa:?}-{pb:?}");
     }

@@ -34,7 +34,7 @@ fn cage_and_creases(fit: &dyn Fitter) -> Result<(PolyMesh, Vec<[u32; 2]>), Expor
         .map_err(|e| ExportError::Unsupported {
             what: e.to_string(),
         })?;
-    let creases = control.creases().into_iter().map(|(a, b)| [a, b]).collect();
+    let creases = control.creases();
     Ok((mesh, creases))
 }
 

@@ -363,13 +363,14 @@ impl ControlMesh {
         PolyMesh::try_new(self.positions.clone(), faces)
     }
 
-    /// Sharp interior edges as vertex pairs `(a, b)` with `a < b`.
-    pub fn creases(&self) -> Vec<(u32, u32)> {
-        let mut out: Vec<(u32, u32)> = (0..self.origin.len() as u32)
+    /// Sharp interior edges as vertex pairs `[a, b]` with `a < b`, sorted (the form
+    /// [`crate::mesh::Features::edges`] and [`crate::mesh::Simplified::creases`] take).
+    pub fn creases(&self) -> Vec<[u32; 2]> {
+        let mut out: Vec<[u32; 2]> = (0..self.origin.len() as u32)
             .filter(|&h| self.sharp[h as usize] && self.twin[h as usize] != NONE)
             .map(|h| {
                 let (a, b) = (self.origin(h), self.target(h));
-                (a.min(b), a.max(b))
+                [a.min(b), a.max(b)]
             })
             .collect();
         out.sort_unstable();
@@ -570,7 +571,7 @@ impl ControlMesh {
             split_face(&corners, &mid, &mut new_faces);
         }
         let mut creases = Vec::new();
-        for (a, b) in self.creases() {
+        for [a, b] in self.creases() {
             match mid(a, b) {
                 Some(m) => creases.extend([(a, m), (m, b)]),
                 None => creases.push((a, b)),

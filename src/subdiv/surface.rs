@@ -294,7 +294,7 @@ impl SubdivSurface {
         let segments = segments.max(1);
         let domain = self.domain();
         let mut out = Vec::new();
-        for (a, b) in self.mesh.creases() {
+        for [a, b] in self.mesh.creases() {
             let Some(h) = self.mesh.find_half_edge(a, b) else {
                 continue;
             };

@@ -245,8 +245,7 @@ impl MeshArrays {
     fn control_of(fit: &dyn crate::fit::Fitter) -> MeshArrays {
         let mut arrays = MeshArrays::of(&fit.control_shape());
         if let Some(surface) = fit.subdiv_surface() {
-            let creases = surface.control_mesh().creases();
-            arrays.creases = creases.into_iter().flat_map(|(a, b)| [a, b]).collect();
+            arrays.creases = surface.control_mesh().creases().concat();
         }
         arrays
     }

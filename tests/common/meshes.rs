@@ -169,3 +169,20 @@ pub fn refine_flat(mesh: &PolyMesh, levels: usize) -> PolyMesh {
     }
     PolyMesh::try_new(pts, tris).expect("refined mesh")
 }
+
+/// How many crease edges (vertex pairs) each vertex of `edges` has.
+pub fn crease_degrees(edges: &[[u32; 2]]) -> std::collections::HashMap<u32, usize> {
+    let mut degree = std::collections::HashMap::new();
+    for e in edges {
+        for v in e {
+            *degree.entry(*v).or_insert(0) += 1;
+        }
+    }
+    degree
+}
+
+/// Whether `p` lies on an edge of the unit cube: two coordinates within `tol` of 0 or 1.
+pub fn on_unit_cube_edge(p: Point3, tol: f64) -> bool {
+    let at_face = |x: f64| x.abs() < tol || (x - 1.0).abs() < tol;
+    [p.x, p.y, p.z].into_iter().filter(|&x| at_face(x)).count() >= 2
+}

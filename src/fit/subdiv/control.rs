@@ -76,17 +76,11 @@ impl ControlSurface for SubdivSurface {
     }
 
     fn refine_control(&self, control: &PolyMesh, marked: &[bool]) -> Result<PolyMesh, FitError> {
-        let creases: Vec<[u32; 2]> = self
-            .control_mesh()
-            .creases()
-            .into_iter()
-            .map(|(a, b)| [a, b])
-            .collect();
         Ok(adaptive::refine_marked(
             SubdivSurface::scheme(self),
             control,
             marked,
-            &creases,
+            &self.control_mesh().creases(),
         )?)
     }
 

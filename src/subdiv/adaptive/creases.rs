@@ -18,7 +18,7 @@ pub fn carried_creases(old: &ControlMesh, refined: &PolyMesh) -> Vec<[u32; 2]> {
         return Vec::new();
     }
     let first_new = old.num_vertices() as u32;
-    let ends: HashSet<u32> = creases.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let ends: HashSet<u32> = creases.iter().flatten().copied().collect();
     let key = |x: u32, y: u32| (x.min(y), x.max(y));
     let mut edges = HashSet::new();
     // The new vertices next to each end of an old crease edge.
@@ -39,7 +39,7 @@ pub fn carried_creases(old: &ControlMesh, refined: &PolyMesh) -> Vec<[u32; 2]> {
     }
     let pos = refined.positions();
     let mut out = Vec::with_capacity(2 * creases.len());
-    for (a, b) in creases {
+    for [a, b] in creases {
         if edges.contains(&(a, b)) {
             out.push([a, b]);
             continue;
