@@ -84,6 +84,21 @@ impl Fairness {
     }
 }
 
+/// How each data point's residual counts in [`Stencils::cg`]: the foot point's normal, the
+/// weight of the tangential part, and the point's own weight (1 where `weights` has none).
+#[derive(Clone, Copy)]
+pub(crate) struct PointFrame<'a> {
+    pub(crate) normals: &'a [Vec3],
+    pub(crate) tangent_weight: f64,
+    pub(crate) weights: &'a [f64],
+}
+
+impl PointFrame<'_> {
+    fn weight(&self, i: usize) -> f64 {
+        self.weights.get(i).copied().unwrap_or(1.0)
+    }
+}
+
 /// Limit stencils of a set of parameters, in compressed rows (one row per data point).
 pub(crate) struct Stencils {
     starts: Vec<usize>,
@@ -154,10 +169,11 @@ impl Stencils {
     }
 
     /// `steps` steps of Jacobi-preconditioned CG on the frozen-parameter least-squares problem
-    /// min Σ_i r_iᵀ M_i r_i, r_i = e_i − Σ_j B_ij Δ_j, with M_i = n_i n_iᵀ + w (I − n_i n_iᵀ):
+    /// min Σ_i ω_i r_iᵀ M_i r_i, r_i = e_i − Σ_j B_ij Δ_j, with M_i = n_i n_iᵀ + w (I − n_i n_iᵀ):
     /// full weight on the distance along the normal n_i, weight `w` = `tangent_weight` on the
     /// tangential slip that frozen parameters create as the surface moves (w = 1 is the plain
-    /// point-to-point problem; smaller w converges faster, as in squared-distance minimisation).
+    /// point-to-point problem; smaller w converges faster, as in squared-distance minimisation),
+    /// and ω_i the point's weight in `frame` (1 unless the fit pulls its worst points in).
     /// With `fair = Some((fairness, points, λ))` the problem gains the umbrella fairness of the
     /// control net at `points + Δ`, control point j's umbrella weighted λ_j times the median
     /// data support of a control point (Σ_i B_ij² over the data). Returns the control-point
@@ -165,22 +181,26 @@ impl Stencils {
     pub(crate) fn cg(
         &self,
         e: &[Vec3],
-        normals: &[Vec3],
-        tangent_weight: f64,
+        frame: PointFrame,
         steps: usize,
         fair: Option<(&Fairness, &[Point3], &[f64])>,
     ) -> Vec<Vec3> {
         let n = self.columns;
         let metric = |i: usize, v: Vec3| {
-            let nrm = normals.get(i).copied().unwrap_or_default();
+            let nrm = frame.normals.get(i).copied().unwrap_or_default();
             let along = nrm * nrm.dot(v);
-            along + (v - along) * tangent_weight
+            (along + (v - along) * frame.tangent_weight) * frame.weight(i)
         };
+        let mut support = vec![0.0; n];
         let mut diag = vec![0.0; n];
-        for &(j, w) in &self.entries {
-            diag[j as usize] += w * w;
+        for i in 0..self.rows() {
+            let weight = frame.weight(i);
+            for &(j, w) in self.row(i) {
+                support[j as usize] += w * w;
+                diag[j as usize] += w * w * weight;
+            }
         }
-        let typical = median(&diag);
+        let typical = median(&support);
         // A control point that the data barely reaches (support below WEAK_SUPPORT of the
         // median) and no fairness holds is all but free in the least-squares problem, and one
         // CG solve can throw it anywhere; a ridge on its move keeps it where it is unless the

@@ -21,7 +21,7 @@ use super::{
 use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
 use crate::subdiv::{tessellate, LimitSurface, PatchDomain, SubdivError, SurfaceParam};
-use frozen::{Fairness, Stencils};
+use frozen::{Fairness, PointFrame, Stencils};
 use index::SurfaceIndex;
 use std::collections::HashSet;
 use web_time::Instant;
@@ -44,6 +44,13 @@ const FAIRNESS_CAP: f64 = 16.0;
 /// A control point whose weight in a straying sample's stencil is below this does not shape
 /// the surface there enough to be held for it.
 const STRAY_STENCIL_WEIGHT: f64 = 0.01;
+
+/// A point farther than this share of the E_max tolerance from the surface gains weight while
+/// E_max is missed ([`SubdivFitter::adapt_point_weights`]).
+const PULL_FROM: f64 = 0.9;
+
+/// The most weight a pulled point gets, relative to the others.
+const PULL_CAP: f64 = 64.0;
 
 /// A data point's foot point on the limit surface.
 type FootPoint = Nearest<SurfaceParam>;
@@ -122,6 +129,8 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// The surface samples of the last [`SubdivFitter::measure_back`] that keep the fit from
     /// converging: farther from the data than [`BACK_TOLERANCE_FACTOR`] E_max tolerances.
     strays: Vec<SurfaceParam>,
+    /// Every data point's weight in the moves (see [`SubdivFitter::adapt_point_weights`]).
+    point_weights: Vec<f64>,
     accel: Accelerator,
     index: SurfaceIndex,
     scratch: Vec<(u32, f64)>,
@@ -172,6 +181,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
             global_fairness: 0.0,
             local_fairness: Vec::new(),
             strays: Vec::new(),
+            point_weights: vec![1.0; data_points.len()],
             accel: Accelerator::new(options.acceleration),
             index,
             scratch: Vec::new(),
@@ -297,7 +307,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let n = self.num_control_points();
         let mut sum = vec![Vec3::ZERO; n];
         let mut weight = vec![0.0; n];
-        for (p, f) in self.state.data().iter().zip(&self.feet) {
+        for ((p, f), &omega) in self
+            .state
+            .data()
+            .iter()
+            .zip(&self.feet)
+            .zip(&self.point_weights)
+        {
             let e = *p - f.point;
             self.scratch.clear();
             match self.options.weighting {
@@ -305,6 +321,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 Weighting::Basis => self.surface.stencil(f.param, &mut self.scratch),
             }
             for &(j, w) in &self.scratch {
+                let w = w * omega;
                 if let (Some(s), Some(t)) = (sum.get_mut(j as usize), weight.get_mut(j as usize)) {
                     *s += e * w;
                     *t += w;
@@ -317,12 +334,25 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .collect()
     }
 
-    /// One move of the control points with damping: a move that raises E_rms is halved (twice at
-    /// most) and otherwise undone. Returns whether a move was kept.
+    /// The weighted sum of squared distances that the moves lower (E_rms² times the number of
+    /// points while every weight is 1).
+    fn objective(&self) -> f64 {
+        self.state
+            .errors()
+            .iter()
+            .zip(&self.point_weights)
+            .map(|(d, w)| w * d * d)
+            .sum()
+    }
+
+    /// One move of the control points with damping: a move that raises the weighted squared
+    /// error ([`SubdivFitter::objective`]) is halved (twice at most) and otherwise undone.
+    /// Returns whether a move was kept.
     fn move_control_points(&mut self) -> bool {
         let old_points = self.surface.control_points().to_vec();
         let old_feet = self.feet.clone();
         let (old_signed, old_stats) = (self.state.errors().to_vec(), self.state.stats());
+        let old_objective = self.objective();
         let d = match self.options.acceleration {
             Acceleration::Cg { inner } => {
                 let stencils = Stencils::build(&self.surface, self.feet.iter().map(|f| f.param));
@@ -335,20 +365,19 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 let fair = fairness
                     .as_ref()
                     .map(|f| (f, old_points.as_slice(), self.fairness.as_slice()));
-                stencils.cg(
-                    &self.error_vectors(),
-                    &normals,
-                    self.options.tangent_weight,
-                    inner,
-                    fair,
-                )
+                let frame = PointFrame {
+                    normals: &normals,
+                    tangent_weight: self.options.tangent_weight,
+                    weights: &self.point_weights,
+                };
+                stencils.cg(&self.error_vectors(), frame, inner, fair)
             }
             _ => self.moves(),
         };
         let proposal = self.accel.propose(&old_points, &d);
         self.surface.set_control_points(&proposal);
         self.update_feet(&old_feet);
-        if !self.options.damping || self.state.stats().e_rms <= old_stats.e_rms * (1.0 + 1e-12) {
+        if !self.options.damping || self.objective() <= old_objective * (1.0 + 1e-12) {
             return true;
         }
         self.accel.reset();
@@ -360,7 +389,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .collect();
             self.surface.set_control_points(&damped);
             self.update_feet(&old_feet);
-            if self.state.stats().e_rms <= old_stats.e_rms {
+            if self.objective() <= old_objective {
                 return true;
             }
         }
@@ -644,15 +673,46 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .collect();
     }
 
+    /// Pulls the worst points in (a Lawson-style reweighting towards the L∞ fit): once no
+    /// refinement is left and while E_max misses its tolerance, a point beyond [`PULL_FROM`]
+    /// of it doubles its weight every iteration (up to [`PULL_CAP`]); a point back under half
+    /// that halves it (down to 1), and so does every weight after a move the damping undid.
+    /// The least-squares moves spread the error evenly, so the few points past a tight E_max
+    /// would otherwise need faces split for them, which the budget no longer allows. Earlier,
+    /// refinement is the better cure: pulling from the first iteration also met E_max on the
+    /// bunny at Table 1 model C, but it moved fits that converged (fandisk with creases at
+    /// the page defaults went from converged with 378 control points to stalled on E_back, its
+    /// pulled points overshooting next to the creases).
+    fn adapt_point_weights(&mut self, moved: bool) {
+        let Some(tmax) = self.state.tolerances().max_pct else {
+            return;
+        };
+        let limit = tmax / 100.0 * self.state.diagonal();
+        let pull = moved && !self.can_refine() && self.state.stats().e_max_pct > tmax;
+        for (w, d) in self.point_weights.iter_mut().zip(self.state.errors()) {
+            let r = d.abs() / limit;
+            if pull && r > PULL_FROM {
+                *w = (*w * 2.0).min(PULL_CAP);
+            } else if !moved || r < PULL_FROM / 2.0 {
+                *w = (*w * 0.5).max(1.0);
+            }
+        }
+    }
+
+    /// Whether a refinement can still change the fit's course: refinement is on, the budget
+    /// has room for [`MIN_GROWTH`] more control points, and the last refinement due added some.
+    fn can_refine(&self) -> bool {
+        let n = self.num_control_points();
+        self.options.refine
+            && self.budget().saturating_sub(n) as f64 >= n as f64 * MIN_GROWTH
+            && !self.refine_exhausted
+    }
+
     /// Whether the fit cannot refine any more and its errors stopped falling (see
     /// [`stalled`]).
     fn is_stalled(&self) -> bool {
-        let n = self.num_control_points();
-        let can_refine = self.options.refine
-            && self.budget().saturating_sub(n) as f64 >= n as f64 * MIN_GROWTH
-            && !self.refine_exhausted;
         let history = self.state.log().history();
-        !can_refine
+        !self.can_refine()
             && self.since_growth >= STALL_WINDOW
             && stalled(
                 history,
@@ -682,6 +742,7 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         let moved = self.move_control_points();
         self.measure_back();
         self.adapt_fairness();
+        self.adapt_point_weights(moved);
         self.since_refine += 1;
         self.since_growth += 1;
         let before_count = self.num_control_points();
