@@ -238,6 +238,14 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .max(self.state.log().initial_control_points())
     }
 
+    /// The E_max tolerance in model units (it is given in % of the diagonal), if there is one.
+    fn max_tolerance(&self) -> Option<f64> {
+        self.state
+            .tolerances()
+            .max_pct
+            .map(|t| t / 100.0 * self.state.diagonal())
+    }
+
     /// Global search: every foot point from the spatial index, then Newton.
     fn search_all_feet(&mut self) -> Result<(), FitError> {
         let opts = self.newton;
@@ -415,7 +423,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
             }
         }
         let t = self.options.tolerances;
-        let tmax = t.max_pct.map(|v| v / 100.0 * self.state.diagonal());
+        let tmax = self.max_tolerance();
         let by = |key: &[f64], keep: &dyn Fn(usize) -> bool| {
             let mut faces: Vec<usize> = (0..nf).filter(|&f| keep(f)).collect();
             faces.sort_by(|&a, &b| key[b].total_cmp(&key[a]).then(a.cmp(&b)));
@@ -597,9 +605,9 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .map(|&at| self.surface.eval(at).point)
             .collect();
         let distances = self.state.measure_back(&samples);
-        let tol = self.state.tolerances().max_pct.map_or(f64::INFINITY, |t| {
-            BACK_TOLERANCE_FACTOR * t / 100.0 * self.state.diagonal()
-        });
+        let tol = self
+            .max_tolerance()
+            .map_or(f64::INFINITY, |t| BACK_TOLERANCE_FACTOR * t);
         self.strays = params
             .into_iter()
             .zip(distances)
@@ -684,10 +692,10 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// the page defaults went from converged with 378 control points to stalled on E_back, its
     /// pulled points overshooting next to the creases).
     fn adapt_point_weights(&mut self, moved: bool) {
-        let Some(tmax) = self.state.tolerances().max_pct else {
+        let (Some(tmax), Some(limit)) = (self.state.tolerances().max_pct, self.max_tolerance())
+        else {
             return;
         };
-        let limit = tmax / 100.0 * self.state.diagonal();
         let pull = moved && !self.can_refine() && self.state.stats().e_max_pct > tmax;
         for (w, d) in self.point_weights.iter_mut().zip(self.state.errors()) {
             let r = d.abs() / limit;
