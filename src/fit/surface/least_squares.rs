@@ -15,6 +15,7 @@
 //! knots. Each iteration solves, then corrects the parameters (Newton foot points), then
 //! splits the patches that miss the tolerance, worst first.
 
+use super::folds::Stiffness;
 use super::normal_system::{for_cell_pairs, span_gram, NormalSystem};
 use super::parameterize::{check_points, parameterize, Parameterization};
 use super::patches::{failing_share, split_worst, PatchGrid};
@@ -119,6 +120,8 @@ pub struct LsqSurfaceFitter {
     /// Parameter area of an initial patch over the domain's: the reference of the per-patch
     /// weight scaling (see [`patch_weights`]).
     ref_cell_area: f64,
+    /// Extra weight of the patches that folded (see [`super::folds`]).
+    stiffness: Stiffness,
 }
 
 impl LsqSurfaceFitter {
@@ -174,6 +177,7 @@ impl LsqSurfaceFitter {
             opts,
             system: None,
             solves_at_knots: 0,
+            stiffness: Stiffness::default(),
         })
     }
 
@@ -203,7 +207,7 @@ impl LsqSurfaceFitter {
         let mut rhs = Mat::<f64>::zeros(nu * nv, 3);
         let count = system.add_points(surface, self.fit.samples(), &mut rhs);
         let grid = PatchGrid::of(surface);
-        let weights = patch_weights(
+        let mut weights = patch_weights(
             surface,
             &grid,
             &self.fit.uv,
@@ -211,6 +215,12 @@ impl LsqSurfaceFitter {
             count,
             self.ref_cell_area,
         );
+        for (w, f) in weights
+            .iter_mut()
+            .zip(self.stiffness.factors(surface, &grid))
+        {
+            *w = w.map(|x| x * f);
+        }
         let scale = count.max(1) as f64;
         system.add_energies(
             surface,
@@ -227,6 +237,26 @@ impl LsqSurfaceFitter {
                 reason: e.to_string(),
             })
     }
+
+    /// Solves; where the solution folds beside the data, stiffens the patches and solves
+    /// once more (see [`super::folds`]). Without smoothing (β2 = β3 = 0) there is nothing to
+    /// stiffen.
+    fn solve_without_folds(&mut self) -> Result<(), FitError> {
+        self.solve()?;
+        if self.opts.beta2 == 0.0 && self.opts.beta3 == 0.0 {
+            return Ok(());
+        }
+        let grid = PatchGrid::of(&self.fit.surface);
+        let held = patch_counts(&self.fit.surface, &grid, &self.fit.uv, &self.fit.active);
+        if self
+            .stiffness
+            .stiffen_folds(&self.fit.surface, &grid, &held)
+            > 0
+        {
+            self.solve()?;
+        }
+        Ok(())
+    }
 }
 
 impl Fitter for LsqSurfaceFitter {
@@ -235,7 +265,7 @@ impl Fitter for LsqSurfaceFitter {
             return Ok(self.status());
         }
         let start = Instant::now();
-        self.solve()?;
+        self.solve_without_folds()?;
         self.solves_at_knots += 1;
         self.fit.correct(self.opts.newton_iterations);
         let (grid, errors) = self.fit.judge(&self.opts.grid);
@@ -299,10 +329,7 @@ fn patch_weights(
     count: usize,
     ref_area: f64,
 ) -> Vec<[f64; 2]> {
-    let mut counts = vec![0usize; grid.len()];
-    for (t, _) in uv.iter().zip(active).filter(|x| *x.1) {
-        counts[grid.patch(surface, t[0], t[1])] += 1;
-    }
+    let counts = patch_counts(surface, grid, uv, active);
     let ((u0, u1), (v0, v1)) = surface.domain();
     let area = (u1 - u0) * (v1 - v0);
     let (ku, kv) = (surface.knots_u().knots(), surface.knots_v().knots());
@@ -320,6 +347,20 @@ fn patch_weights(
             [s * s / rho, s * s * s * rho]
         })
         .collect()
+}
+
+/// The number of points taking part in the fit in every patch.
+fn patch_counts(
+    surface: &BSplineSurface,
+    grid: &PatchGrid,
+    uv: &[[f64; 2]],
+    active: &[bool],
+) -> Vec<usize> {
+    let mut counts = vec![0usize; grid.len()];
+    for (t, _) in uv.iter().zip(active).filter(|x| *x.1) {
+        counts[grid.patch(surface, t[0], t[1])] += 1;
+    }
+    counts
 }
 
 /// E2 and E3 of `surface`, unweighted, from the same exact quadrature as the fit.

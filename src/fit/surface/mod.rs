@@ -79,6 +79,7 @@ macro_rules! surface_fitter_methods {
     };
 }
 
+mod folds;
 mod geometric;
 mod least_squares;
 mod normal_system;
