@@ -122,6 +122,71 @@ pub struct LsqSurfaceFitter {
     ref_cell_area: f64,
     /// Extra weight of the patches that folded (see [`super::folds`]).
     stiffness: Stiffness,
+    /// What the last full solve assembled, for [`LsqSurfaceFitter::resolve_stiffened`].
+    last: Option<LastSolve>,
+}
+
+/// The right-hand side of the last full solve and its per-patch energy weights (β2 and β3
+/// included, before the stiffness factors).
+struct LastSolve {
+    rhs: Mat<f64>,
+    energy: Vec<[f64; 2]>,
+}
+
+/// Control points beyond a stiffened patch's own that its window frees, per side: two patch
+/// supports, so the held points lie where the change has died out.
+const WINDOW_PAD: usize = 8;
+
+/// A re-solve by windows is used while the windows hold less than 1/`WINDOW_SHARE` of the
+/// control points.
+const WINDOW_SHARE: usize = 4;
+
+/// The control-point rectangles (rows, columns) freed for the re-solve after stiffening the
+/// patches `changed` of `grid`: each patch's (p + 1) × (q + 1) control points padded by
+/// [`WINDOW_PAD`], merged while two come within the coupling reach (p rows, q columns) of
+/// each other, so that no two windows share an equation.
+fn stiffened_windows(
+    grid: &PatchGrid,
+    changed: &[usize],
+    (nu, nv): (usize, usize),
+    (p, q): (usize, usize),
+) -> Vec<(std::ops::Range<usize>, std::ops::Range<usize>)> {
+    let span = |first: usize, order: usize, n: usize| {
+        first.saturating_sub(WINDOW_PAD)..(first + order + WINDOW_PAD).min(n)
+    };
+    let mut windows: Vec<_> = changed
+        .iter()
+        .map(|&i| {
+            let (cu, cv) = (i / grid.v.len(), i % grid.v.len());
+            (
+                span(grid.u.knot_index(cu) - p, p + 1, nu),
+                span(grid.v.knot_index(cv) - q, q + 1, nv),
+            )
+        })
+        .collect();
+    let near = |a: &std::ops::Range<usize>, b: &std::ops::Range<usize>, reach: usize| {
+        a.start < b.end + reach && b.start < a.end + reach
+    };
+    let mut merged = true;
+    while merged {
+        merged = false;
+        let mut out: Vec<(std::ops::Range<usize>, std::ops::Range<usize>)> = Vec::new();
+        for w in windows {
+            match out
+                .iter_mut()
+                .find(|o| near(&o.0, &w.0, p) && near(&o.1, &w.1, q))
+            {
+                Some(o) => {
+                    o.0 = o.0.start.min(w.0.start)..o.0.end.max(w.0.end);
+                    o.1 = o.1.start.min(w.1.start)..o.1.end.max(w.1.end);
+                    merged = true;
+                }
+                None => out.push(w),
+            }
+        }
+        windows = out;
+    }
+    windows
 }
 
 impl LsqSurfaceFitter {
@@ -178,6 +243,7 @@ impl LsqSurfaceFitter {
             system: None,
             solves_at_knots: 0,
             stiffness: Stiffness::default(),
+            last: None,
         })
     }
 
@@ -215,27 +281,89 @@ impl LsqSurfaceFitter {
             count,
             self.ref_cell_area,
         );
-        for (w, f) in weights
+        let scale = count.max(1) as f64;
+        let (b2, b3) = (self.opts.beta2 * scale, self.opts.beta3 * scale);
+        for w in weights.iter_mut() {
+            *w = [w[0] * b2, w[1] * b3];
+        }
+        let mut stiffened = weights.clone();
+        for (w, f) in stiffened
             .iter_mut()
             .zip(self.stiffness.factors(surface, &grid))
         {
             *w = w.map(|x| x * f);
         }
-        let scale = count.max(1) as f64;
-        system.add_energies(
-            surface,
-            &grid,
-            &weights,
-            self.opts.beta2 * scale,
-            self.opts.beta3 * scale,
-        );
+        system.add_energies(surface, &grid, &stiffened, 1.0, 1.0);
+        self.last = Some(LastSolve {
+            rhs: rhs.clone(),
+            energy: weights,
+        });
         let control = system.solve(rhs)?;
+        self.set_control(&control)
+    }
+
+    fn set_control(&mut self, control: &[Point3]) -> Result<(), FitError> {
         self.fit
             .surface
-            .set_control_points(&control)
+            .set_control_points(control)
             .map_err(|e| FitError::Solver {
                 reason: e.to_string(),
             })
+    }
+
+    /// Re-solves after the patches `changed` were stiffened from `before` to `after` (their
+    /// factors): adds the energy the stiffening adds, then solves for the control points near
+    /// those patches alone, the others held, window by window (a block Gauss–Seidel step on the
+    /// new system). Falls back to a full solve when the windows would cover much of the grid.
+    ///
+    /// Why: the stiffening changes the solution only where it acts (the data pin the rest), and
+    /// a window's factorisation costs a fraction of the whole grid's, which dominated the fit's
+    /// time when every step solved twice.
+    fn resolve_stiffened(
+        &mut self,
+        grid: &PatchGrid,
+        before: &[f64],
+        after: &[f64],
+    ) -> Result<(), FitError> {
+        let surface = &self.fit.surface;
+        let (nu, nv) = surface.num_control();
+        let (p, q) = (surface.knots_u().degree(), surface.knots_v().degree());
+        let (Some(system), Some(last)) = (self.system.as_mut(), self.last.as_ref()) else {
+            return self.solve();
+        };
+        let changed: Vec<usize> = (0..after.len())
+            .filter(|&i| after[i] != before[i])
+            .collect();
+        let windows = stiffened_windows(grid, &changed, (nu, nv), (p, q));
+        let area: usize = windows.iter().map(|(r, c)| r.len() * c.len()).sum();
+        if area * WINDOW_SHARE > nu * nv {
+            return self.solve();
+        }
+        let delta: Vec<[f64; 2]> = last
+            .energy
+            .iter()
+            .zip(before.iter().zip(after))
+            .map(|(w, (b, a))| w.map(|x| x * (a - b)))
+            .collect();
+        system.add_energies(surface, grid, &delta, 1.0, 1.0);
+        let mut x = surface.control_points().to_vec();
+        for (rows, cols) in windows {
+            let mut sub = system.window(rows.clone(), cols.clone())?;
+            let wv = cols.len();
+            let index = |k: usize| (rows.start + k / wv) * nv + cols.start + k % wv;
+            let mut r = Mat::<f64>::zeros(rows.len() * wv, 3);
+            for k in 0..rows.len() * wv {
+                let g = index(k);
+                let ax = system.row_times(g, &x);
+                for d in 0..3 {
+                    r[(k, d)] = last.rhs[(g, d)] - ax[d];
+                }
+            }
+            for (k, dx) in sub.solve(r)?.into_iter().enumerate() {
+                x[index(k)] += dx;
+            }
+        }
+        self.set_control(&x)
     }
 
     /// Solves; where the solution folds beside the data, stiffens the patches and solves
@@ -248,14 +376,16 @@ impl LsqSurfaceFitter {
         }
         let grid = PatchGrid::of(&self.fit.surface);
         let held = patch_counts(&self.fit.surface, &grid, &self.fit.uv, &self.fit.active);
+        let before = self.stiffness.factors(&self.fit.surface, &grid);
         if self
             .stiffness
             .stiffen_folds(&self.fit.surface, &grid, &held)
-            > 0
+            == 0
         {
-            self.solve()?;
+            return Ok(());
         }
-        Ok(())
+        let after = self.stiffness.factors(&self.fit.surface, &grid);
+        self.resolve_stiffened(&grid, &before, &after)
     }
 }
 

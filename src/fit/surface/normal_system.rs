@@ -330,6 +330,9 @@ impl NormalSystem {
             for (cv, gv) in grams_v.iter().enumerate() {
                 let fv = grid.v.knot_index(cv) - q;
                 let [w2, w3] = weights[cu * grid.v.len() + cv];
+                if w2 == 0.0 && w3 == 0.0 {
+                    continue;
+                }
                 let w = combined_v_tables(gv, beta2 * w2, beta3 * w3);
                 let u = &gu.g;
                 self.add_block((fu, fv), |k, l| {
@@ -386,6 +389,53 @@ impl NormalSystem {
             });
         }
         Ok(out)
+    }
+}
+
+impl NormalSystem {
+    /// Row `c` of the assembled matrix times `x` (one control point per column).
+    pub(super) fn row_times(&self, c: usize, x: &[Point3]) -> Point3 {
+        let (nu, nv, p, q) = self.shape;
+        let (ci, cj) = (c / nv, c % nv);
+        let mut y = Point3::ZERO;
+        for ri in ci.saturating_sub(p)..(ci + p + 1).min(nu) {
+            for rj in cj.saturating_sub(q)..(cj + q + 1).min(nv) {
+                let r = ri * nv + rj;
+                // The upper triangle holds entry (c, r) in the later of the two columns.
+                let (col, (i, j)) = if r <= c { (c, (ri, rj)) } else { (r, (ci, cj)) };
+                y += self.values[self.band(col).at(i, j)] * x[r];
+            }
+        }
+        y
+    }
+
+    /// The system of the control points in `rows × cols` of the grid alone (the others held
+    /// fixed), its values copied from this one.
+    pub(super) fn window(
+        &self,
+        rows: std::ops::Range<usize>,
+        cols: std::ops::Range<usize>,
+    ) -> Result<NormalSystem, FitError> {
+        let (_, nv, p, q) = self.shape;
+        let (wu, wv) = (rows.len(), cols.len());
+        let mut sub = NormalSystem::new(wu, wv, p.min(wu - 1), q.min(wv - 1))?;
+        for c in 0..wu * wv {
+            let local = sub.band(c);
+            let global = self.band((rows.start + c / wv) * nv + cols.start + c % wv);
+            let (ci, cj) = (c / wv, c % wv);
+            for ri in local.i0..=ci {
+                let j_end = if ri == ci {
+                    cj
+                } else {
+                    local.j0 + local.width - 1
+                };
+                for rj in local.j0..=j_end {
+                    sub.values[local.at(ri, rj)] =
+                        self.values[global.at(rows.start + ri, cols.start + rj)];
+                }
+            }
+        }
+        Ok(sub)
     }
 }
 
@@ -519,5 +569,66 @@ mod tests {
             sys.factor.len_val(),
             amd.len_val()
         );
+    }
+
+    /// A 9 × 8 grid system (p = q = 3) with deterministic, diagonally dominant values.
+    fn dominant_system() -> NormalSystem {
+        let (nu, nv) = (9, 8);
+        let mut sys = NormalSystem::new(nu, nv, 3, 3).expect("pattern");
+        for c in 0..nu * nv {
+            let band = sys.band(c);
+            for k in band.start..sys.col_ptr[c + 1] {
+                sys.values[k] = ((k * 7919) % 13) as f64 / 13.0 - 0.5;
+            }
+            sys.values[sys.col_ptr[c + 1] - 1] = 60.0 + c as f64;
+        }
+        sys
+    }
+
+    #[test]
+    fn rows_times_a_vector_match_the_dense_product() {
+        let sys = dominant_system();
+        let n = 72;
+        let mut dense = vec![vec![0.0; n]; n];
+        let rows = sys.symbolic.row_idx();
+        for c in 0..n {
+            for k in sys.col_ptr[c]..sys.col_ptr[c + 1] {
+                dense[rows[k]][c] = sys.values[k];
+                dense[c][rows[k]] = sys.values[k];
+            }
+        }
+        let x: Vec<Point3> = (0..n)
+            .map(|i| Point3::new(i as f64, (i * i) as f64 * 0.01, 1.0 - i as f64))
+            .collect();
+        for (c, row) in dense.iter().enumerate() {
+            let want: Point3 = row.iter().zip(&x).map(|(a, x)| *a * *x).sum();
+            assert!((sys.row_times(c, &x) - want).length() < 1e-9, "row {c}");
+        }
+    }
+
+    #[test]
+    fn a_window_solve_zeroes_the_residual_inside_and_the_whole_window_is_the_system() {
+        let mut sys = dominant_system();
+        let b: Vec<Point3> = (0..72).map(|i| Point3::splat(1.0 + i as f64)).collect();
+        let to_mat = |v: &[Point3]| Mat::<f64>::from_fn(v.len(), 3, |i, d| v[i][d]);
+        let full = sys.solve(to_mat(&b)).expect("full solve");
+        let mut whole = sys.window(0..9, 0..8).expect("whole");
+        let again = whole.solve(to_mat(&b)).expect("window solve");
+        for (a, f) in again.iter().zip(&full) {
+            assert!((*a - *f).length() < 1e-12);
+        }
+        // From x = 0, one solve of rows 2..7 × columns 1..6: the residual vanishes there.
+        let (rows, cols) = (2..7, 1..6);
+        let mut sub = sys.window(rows.clone(), cols.clone()).expect("window");
+        let index = |k: usize| (rows.start + k / 5) * 8 + cols.start + k % 5;
+        let r: Vec<Point3> = (0..25).map(|k| b[index(k)]).collect();
+        let mut x = vec![Point3::ZERO; 72];
+        for (k, d) in sub.solve(to_mat(&r)).expect("sub").into_iter().enumerate() {
+            x[index(k)] = d;
+        }
+        for k in 0..25 {
+            let g = index(k);
+            assert!((b[g] - sys.row_times(g, &x)).length() < 1e-10, "row {g}");
+        }
     }
 }
