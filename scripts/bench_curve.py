@@ -119,7 +119,7 @@ def corner_jumps(spline, knots, degree):
 
 
 def geofit_fit(section, method, diag, points, tol):
-    exe = REPO / "target" / "release" / "geofit"
+    exe = Path(os.environ.get("CARGO_TARGET_DIR") or REPO / "target") / "release" / "geofit"
     if not exe.exists():
         subprocess.run(["cargo", "build", "--release", "--bin", "geofit"], cwd=REPO, check=True)
     with tempfile.TemporaryDirectory() as tmp:

@@ -284,7 +284,8 @@ def occ_fit(resampler, diag, count, mode):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--data", default=default_data())
-    ap.add_argument("--geofit", default=os.path.join(ROOT, "target", "release", "geofit"))
+    target_dir = os.environ.get("CARGO_TARGET_DIR") or os.path.join(ROOT, "target")
+    ap.add_argument("--geofit", default=os.path.join(target_dir, "release", "geofit"))
     ap.add_argument("--counts", default="400,1600,6400")
     ap.add_argument("--tols", default="0.1,0.05", help="tolerances (%%) of the adaptive geofit runs")
     ap.add_argument("--json", help="also write the table as JSON to this file")
