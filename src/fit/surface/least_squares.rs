@@ -15,7 +15,7 @@
 //! knots. Each iteration solves, then corrects the parameters (Newton foot points), then
 //! splits the patches that miss the tolerance, worst first.
 
-use super::folds::{patches_to_stiffen, STIFF};
+use super::folds::Stiffness;
 use super::normal_system::{for_cell_pairs, span_gram, NormalSystem};
 use super::parameterize::{check_points, parameterize, Parameterization};
 use super::patches::{failing_share, split_worst, PatchGrid};
@@ -120,12 +120,14 @@ pub struct LsqSurfaceFitter {
     /// Parameter area of an initial patch over the domain's: the reference of the per-patch
     /// weight scaling (see [`patch_weights`]).
     ref_cell_area: f64,
+    /// Extra weight of the patches that folded (see [`super::folds`]).
+    stiffness: Stiffness,
     /// What the last full solve assembled, for [`LsqSurfaceFitter::resolve_stiffened`].
     last: Option<LastSolve>,
 }
 
 /// The right-hand side of the last full solve and its per-patch energy weights (β2 and β3
-/// included).
+/// included, before the stiffness factors).
 struct LastSolve {
     rhs: Mat<f64>,
     energy: Vec<[f64; 2]>,
@@ -240,6 +242,7 @@ impl LsqSurfaceFitter {
             opts,
             system: None,
             solves_at_knots: 0,
+            stiffness: Stiffness::default(),
             last: None,
         })
     }
@@ -283,7 +286,14 @@ impl LsqSurfaceFitter {
         for w in weights.iter_mut() {
             *w = [w[0] * b2, w[1] * b3];
         }
-        system.add_energies(surface, &grid, &weights, 1.0, 1.0);
+        let mut stiffened = weights.clone();
+        for (w, f) in stiffened
+            .iter_mut()
+            .zip(self.stiffness.factors(surface, &grid))
+        {
+            *w = w.map(|x| x * f);
+        }
+        system.add_energies(surface, &grid, &stiffened, 1.0, 1.0);
         self.last = Some(LastSolve {
             rhs: rhs.clone(),
             energy: weights,
@@ -301,32 +311,41 @@ impl LsqSurfaceFitter {
             })
     }
 
-    /// Re-solves with the patches `stiff` of `grid` [`STIFF`] times as smooth: adds the energy
-    /// that adds, then solves for the control points near those patches alone, the others
-    /// held, window by window (a block Gauss–Seidel step on the new system). A full solve
-    /// when the windows would cover much of the grid.
+    /// Re-solves after the patches `changed` were stiffened from `before` to `after` (their
+    /// factors): adds the energy the stiffening adds, then solves for the control points near
+    /// those patches alone, the others held, window by window (a block Gauss–Seidel step on the
+    /// new system). Falls back to a full solve when the windows would cover much of the grid.
     ///
     /// Why: the stiffening changes the solution only where it acts (the data pin the rest), and
     /// a window's factorisation costs a fraction of the whole grid's, which dominated the fit's
     /// time when every step solved twice.
-    fn resolve_stiffened(&mut self, grid: &PatchGrid, stiff: &[usize]) -> Result<(), FitError> {
+    fn resolve_stiffened(
+        &mut self,
+        grid: &PatchGrid,
+        before: &[f64],
+        after: &[f64],
+    ) -> Result<(), FitError> {
         let surface = &self.fit.surface;
         let (nu, nv) = surface.num_control();
         let (p, q) = (surface.knots_u().degree(), surface.knots_v().degree());
         let (Some(system), Some(last)) = (self.system.as_mut(), self.last.as_ref()) else {
             return self.solve();
         };
-        let windows = stiffened_windows(grid, stiff, (nu, nv), (p, q));
+        let changed: Vec<usize> = (0..after.len())
+            .filter(|&i| after[i] != before[i])
+            .collect();
+        let windows = stiffened_windows(grid, &changed, (nu, nv), (p, q));
         let area: usize = windows.iter().map(|(r, c)| r.len() * c.len()).sum();
-        let mut delta = vec![[0.0; 2]; grid.len()];
-        for &i in stiff {
-            delta[i] = last.energy[i].map(|x| x * (STIFF - 1.0));
-        }
-        system.add_energies(surface, grid, &delta, 1.0, 1.0);
         if area * WINDOW_SHARE > nu * nv {
-            let control = system.solve(last.rhs.clone())?;
-            return self.set_control(&control);
+            return self.solve();
         }
+        let delta: Vec<[f64; 2]> = last
+            .energy
+            .iter()
+            .zip(before.iter().zip(after))
+            .map(|(w, (b, a))| w.map(|x| x * (a - b)))
+            .collect();
+        system.add_energies(surface, grid, &delta, 1.0, 1.0);
         let mut x = surface.control_points().to_vec();
         for (rows, cols) in windows {
             let mut sub = system.window(rows.clone(), cols.clone())?;
@@ -347,21 +366,27 @@ impl LsqSurfaceFitter {
         self.set_control(&x)
     }
 
-    /// Solves; where the solution folds beside the data, stiffens the patches and solves
-    /// once more (see [`super::folds`]). Without smoothing (β2 = β3 = 0) there is nothing to
-    /// stiffen.
+    /// Relaxes the stiffness of earlier steps, solves; where the solution folds beside the
+    /// data, stiffens the patches and solves once more (see [`super::folds`]). Without
+    /// smoothing (β2 = β3 = 0) there is nothing to stiffen.
     fn solve_without_folds(&mut self) -> Result<(), FitError> {
+        self.stiffness.relax();
         self.solve()?;
         if self.opts.beta2 == 0.0 && self.opts.beta3 == 0.0 {
             return Ok(());
         }
         let grid = PatchGrid::of(&self.fit.surface);
         let held = patch_counts(&self.fit.surface, &grid, &self.fit.uv, &self.fit.active);
-        let stiff = patches_to_stiffen(&self.fit.surface, &grid, &held);
-        if stiff.is_empty() {
+        let before = self.stiffness.factors(&self.fit.surface, &grid);
+        if self
+            .stiffness
+            .stiffen_folds(&self.fit.surface, &grid, &held)
+            == 0
+        {
             return Ok(());
         }
-        self.resolve_stiffened(&grid, &stiff)
+        let after = self.stiffness.factors(&self.fit.surface, &grid);
+        self.resolve_stiffened(&grid, &before, &after)
     }
 }
 
