@@ -3,10 +3,15 @@
 
 Fits a B-spline surface with `geofit fit --scheme bspline-surface` to bun000.ply (a single-view
 range scan with holes) and to a synthetic height field with a round hole, exports STEP and IGES,
-reads both back with OCC and checks: one face, and its area (BRepGProp.SurfaceProperties,
-adaptive to 1e-6) within 5 % of the data's triangulated region (`trim.data_area` of the fit
-report: the outline's Delaunay triangles with the data points at their corners), and
-BRepCheck_Analyzer finds the face valid. A third case, the patch without its hole, is data
+reads both back with OCC and checks: one face; its area (BRepGProp.SurfaceProperties,
+adaptive to 1e-6) within 1 % of the trimmed area geofit reports (`trim.trimmed_area`: OCC reads
+the trim as geofit means it) and within 8 % of the data's triangulated region (`trim.data_area`:
+the outline's Delaunay triangles with the data points at their corners); and BRepCheck_Analyzer
+finds the face valid. The 8 %: bun000's fitted surface has 6 % less area in the outline than its
+data's triangulation, which carries the scan noise and the triangles over the outline's dropped
+islands; before the least-squares fit stiffened its folds it was 2.2 % less, the folds adding
+area (the surface within 0.5 % of the diagonal from the data had 0.0252 against 0.0230 now and
+0.0216 for the data). A third case, the patch without its hole, is data
 covering the whole domain: the trim follows the domain's edges and the face stays valid.
 
 Run: python tests/interop/test_trim_occ.py   (exit status 1 on any failure)
@@ -30,7 +35,8 @@ from OCP.TopExp import TopExp_Explorer
 
 from geofit_cli import REPO, geofit_bin
 
-AREA_TOL = 0.05
+AREA_TOL = 0.08
+EXPORT_TOL = 0.01
 
 
 def read_shape(path):
@@ -86,10 +92,12 @@ def main():
                 shape = read_shape(Path(f"{out}{ext}"))
                 a, valid, n = area(shape), BRepCheck_Analyzer(shape).IsValid(), faces(shape)
                 rel = a / trim["data_area"] - 1
-                ok = n == 1 and abs(rel) <= AREA_TOL and valid
+                own = a / trim["trimmed_area"] - 1
+                ok = n == 1 and abs(rel) <= AREA_TOL and abs(own) <= EXPORT_TOL and valid
                 failures += not ok
                 print(f"{'ok  ' if ok else 'FAIL'} {name}{ext}: {n} face, valid {valid}, area {a:.6g} "
                       f"vs data {trim['data_area']:.6g} ({100 * rel:+.2f} %), "
+                      f"vs geofit's trimmed area {trim['trimmed_area']:.6g} ({100 * own:+.2f} %), "
                       f"{trim['loops']} loops, {trim['vertices']} vertices")
     return 1 if failures else 0
 
