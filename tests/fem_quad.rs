@@ -8,7 +8,7 @@ use geofit::fem::{mesh_bspline, mesh_fit, mesh_limit, FemError, FemOptions, MAX_
 use geofit::fit::{FitData, FitSpec, Scheme};
 use geofit::geom::Point3;
 use geofit::io::{read_path, to_msh_bytes};
-use geofit::spline::{BSplineSurface, KnotVector};
+use geofit::spline::{BSplineSurface, KnotVector, TrimRegion};
 use geofit::subdiv::{CatmullClarkSurface, LoopSurface};
 
 /// A bilinear `w × h` rectangle in the xy plane (u along x).
@@ -121,14 +121,22 @@ fn curved_parts_get_smaller_elements() {
 fn the_trim_drops_elements_with_every_corner_outside() {
     let s = rectangle(1.0, 1.0);
     let options = FemOptions::default().with_edge(0.1);
-    // Inside: the disc of radius 0.3 about the centre.
-    let inside = |u: f64, v: f64| (u - 0.5).powi(2) + (v - 0.5).powi(2) < 0.09;
-    let fem = mesh_bspline(&s, &options, Some(&inside)).unwrap();
+    // Inside: a 64-gon of radius 0.3 about the centre.
+    let disc = (0..64)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / 64.0;
+            [0.5 + 0.3 * a.cos(), 0.5 + 0.3 * a.sin()]
+        })
+        .collect();
+    let region = TrimRegion::try_new(disc, Vec::new()).unwrap();
+    let fem = mesh_bspline(&s, &options, Some(&region)).unwrap();
     let m = fem.mesh();
     let p = m.positions();
     // An element is kept when a corner is inside the disc: near it, and none far outside.
     for f in m.faces() {
-        assert!(f.iter().any(|&i| inside(p[i as usize].x, p[i as usize].y)));
+        assert!(f
+            .iter()
+            .any(|&i| region.contains(p[i as usize].x, p[i as usize].y)));
     }
     let full = mesh_bspline(&s, &options, None).unwrap().quality().elements;
     assert!(fem.quality().elements < full / 2 && fem.quality().elements > 28);
@@ -136,8 +144,8 @@ fn the_trim_drops_elements_with_every_corner_outside() {
     let mut used = vec![false; p.len()];
     m.faces().flatten().for_each(|&i| used[i as usize] = true);
     assert!(used.iter().all(|&u| u));
-    let nothing = |_: f64, _: f64| false;
-    let err = mesh_bspline(&s, &options, Some(&nothing)).unwrap_err();
+    let away = TrimRegion::try_new(vec![[5.0, 5.0], [6.0, 5.0], [5.0, 6.0]], Vec::new()).unwrap();
+    let err = mesh_bspline(&s, &options, Some(&away)).unwrap_err();
     assert_eq!(err, FemError::Empty);
 }
 

@@ -4,28 +4,28 @@
 use super::grading::{equidistribute, intervals, max_curvature, resolve_size};
 use super::{FemError, FemMesh, FemOptions, FemSize, MAX_ELEMENTS};
 use crate::geom::{Aabb, Point3, Vec3};
-use crate::spline::{BSplineSurface, KnotVector, MAX_DEGREE};
+use crate::spline::{BSplineSurface, KnotVector, TrimRegion, MAX_DEGREE};
 
-/// The FEM quad mesh of `surface` (see the [module](super) docs). `inside(u, v)`, when given,
-/// trims it: elements whose four corners are all outside are dropped. A count asks for that
+/// The FEM quad mesh of `surface` (see the [module](super) docs). `trim`, when given, trims
+/// it: elements whose four corners are all outside the region are dropped. A count asks for that
 /// many elements inside: the lines are laid out once for the whole domain, then once more with
 /// the count scaled by the share of elements the trim kept (a second pass only when it dropped
 /// some), so a trimmed mesh is about as fine as the count says, not coarser by the trim.
 pub fn mesh_bspline(
     surface: &BSplineSurface,
     options: &FemOptions,
-    inside: Option<&dyn Fn(f64, f64) -> bool>,
+    trim: Option<&TrimRegion>,
 ) -> Result<FemMesh, FemError> {
     options.validate()?;
     let field = SizeField::sample(surface);
     let grid = Grid::lay_out(surface, &field, options, options.size)?;
-    let (kept, total) = grid.quads(inside);
+    let (kept, total) = grid.quads(trim);
     let share = kept.len() as f64 / total.max(1) as f64;
     let (grid, quads) = match options.size {
         FemSize::Count(n) if share > 0.0 && share < 1.0 => {
             let scaled = ((n as f64 / share).round() as usize).min(MAX_ELEMENTS);
             let grid = Grid::lay_out(surface, &field, options, FemSize::Count(scaled))?;
-            let (quads, _) = grid.quads(inside);
+            let (quads, _) = grid.quads(trim);
             (grid, quads)
         }
         _ => (grid, kept),
@@ -62,17 +62,12 @@ impl Grid {
         })
     }
 
-    /// The quads `inside` keeps (all without one; node `(i, j)` is `i * vs.len() + j`), and
+    /// The quads `trim` keeps (all without one; node `(i, j)` is `i * vs.len() + j`), and
     /// how many there are in all.
-    fn quads(&self, inside: Option<&dyn Fn(f64, f64) -> bool>) -> (Vec<[u32; 4]>, usize) {
+    fn quads(&self, trim: Option<&TrimRegion>) -> (Vec<[u32; 4]>, usize) {
         let nv = self.vs.len();
         let id = |i: usize, j: usize| (i * nv + j) as u32;
-        let keep: Option<Vec<bool>> = inside.map(|f| {
-            self.us
-                .iter()
-                .flat_map(|&u| self.vs.iter().map(move |&v| f(u, v)))
-                .collect()
-        });
+        let keep = trim.map(|r| r.contains_grid(&self.us, &self.vs));
         let total = (self.us.len() - 1) * (nv - 1);
         let mut quads = Vec::with_capacity(total);
         for i in 0..self.us.len() - 1 {

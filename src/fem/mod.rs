@@ -257,10 +257,7 @@ impl FemMesh {
 pub fn mesh_fit(fit: &dyn Fitter, options: &FemOptions) -> Result<FemMesh, FemError> {
     if let Some(Spline::Surface { surface, params }) = fit.spline() {
         let region = options.trim.then(|| data_region(surface, params)).flatten();
-        let inside = region
-            .as_ref()
-            .map(|r| move |u: f64, v: f64| r.contains(u, v));
-        return mesh_bspline(surface, options, inside.as_ref().map(|f| f as _));
+        return mesh_bspline(surface, options, region.as_ref());
     }
     match fit.subdiv_surface() {
         Some(surface) => mesh_limit(surface, options),

@@ -152,6 +152,28 @@ impl TrimRegion {
         self.loops().filter(|l| crosses(l, u, v)).count() % 2 == 1
     }
 
+    /// [`TrimRegion::contains`] at every node (us[i], vs[j]) of a grid, at `i * vs.len() + j`.
+    ///
+    /// Why: a test per node walks every loop edge, which made the inside tests of a 390K-node
+    /// FEM mesh cost 0.5 s; here each v line's crossings with all loops are found once and
+    /// sorted, and a node counts those beyond it by binary search: O(lines × edges + nodes ×
+    /// log edges), the same answers (the same crossing arithmetic, and the parities of the
+    /// loops add up to the parity of their sum).
+    pub fn contains_grid(&self, us: &[f64], vs: &[f64]) -> Vec<bool> {
+        let mut inside = vec![false; us.len() * vs.len()];
+        let mut xs = Vec::new();
+        for (j, &v) in vs.iter().enumerate() {
+            xs.clear();
+            xs.extend(self.loops().flat_map(|l| crossings(l, v)));
+            xs.sort_unstable_by(f64::total_cmp);
+            for (i, &u) in us.iter().enumerate() {
+                let beyond = xs.len() - xs.partition_point(|&x| x <= u);
+                inside[i * vs.len() + j] = beyond % 2 == 1;
+            }
+        }
+        inside
+    }
+
     /// Area in (u, v): the outer loop's less the holes'.
     pub fn area(&self) -> f64 {
         self.loops().map(signed_area).sum()
@@ -400,18 +422,21 @@ fn signed_area(l: &[[f64; 2]]) -> f64 {
 
 /// Whether a ray from (u, v) towards +u crosses the loop an odd number of times.
 fn crosses(l: &[[f64; 2]], u: f64, v: f64) -> bool {
+    crossings(l, v).filter(|&x| u < x).count() % 2 == 1
+}
+
+/// The u of every crossing of loop `l` with the line at `v` (edges with one end above `v`
+/// and one at or below): the ray of the even–odd rule runs from (u, v) towards +u, so a point
+/// is inside a loop when an odd number of these lie beyond its u.
+fn crossings(l: &[[f64; 2]], v: f64) -> impl Iterator<Item = f64> + '_ {
     let n = l.len();
-    let mut inside = false;
-    for i in 0..n {
+    (0..n).filter_map(move |i| {
         let (a, b) = (l[i], l[(i + 1) % n]);
-        if (a[1] > v) != (b[1] > v) {
+        ((a[1] > v) != (b[1] > v)).then(|| {
             let t = (v - a[1]) / (b[1] - a[1]);
-            if u < a[0] + t * (b[0] - a[0]) {
-                inside = !inside;
-            }
-        }
-    }
-    inside
+            a[0] + t * (b[0] - a[0])
+        })
+    })
 }
 
 /// Douglas–Peucker on a closed loop, split at two extreme vertices (the one farthest from the
@@ -470,6 +495,42 @@ fn douglas_peucker(p: &[[f64; 2]], a: usize, b: usize, tol: f64, keep: &mut [boo
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn grid_inside_tests_equal_pointwise_ones() {
+        // A star-shaped outer loop with a square hole; grid lines through its vertices too.
+        let outer: Vec<[f64; 2]> = (0..14)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::TAU / 14.0;
+                let r = if k % 2 == 0 { 1.0 } else { 0.45 };
+                [r * a.cos(), r * a.sin()]
+            })
+            .collect();
+        let hole = vec![[-0.2, -0.2], [0.2, -0.2], [0.2, 0.2], [-0.2, 0.2]];
+        let region = TrimRegion::try_new(outer, vec![hole]).unwrap();
+        let lines = |n: usize| -> Vec<f64> {
+            let mut t: Vec<f64> = (0..n)
+                .map(|i| -1.1 + 2.2 * i as f64 / (n - 1) as f64)
+                .collect();
+            t.extend([-0.2, 0.2, 0.0, 1.0]);
+            t
+        };
+        let (us, vs) = (lines(57), lines(43));
+        let grid = region.contains_grid(&us, &vs);
+        let mut inside = 0;
+        for (i, &u) in us.iter().enumerate() {
+            for (j, &v) in vs.iter().enumerate() {
+                assert_eq!(
+                    grid[i * vs.len() + j],
+                    region.contains(u, v),
+                    "at ({u}, {v})"
+                );
+                inside += usize::from(grid[i * vs.len() + j]);
+            }
+        }
+        assert!(inside > 100 && inside < us.len() * vs.len() / 2, "{inside}");
+        assert!(!region.contains(0.0, 0.0), "the hole is outside");
+    }
 
     #[test]
     fn simplify_keeps_corners_of_a_sampled_square() {
