@@ -312,9 +312,11 @@ impl LsqSurfaceFitter {
     }
 
     /// Re-solves after the patches `changed` were stiffened from `before` to `after` (their
-    /// factors): adds the energy the stiffening adds, then solves for the control points near
-    /// those patches alone, the others held, window by window (a block Gauss–Seidel step on the
-    /// new system). Falls back to a full solve when the windows would cover much of the grid.
+    /// factors): adds the energy the stiffening adds to the assembled system, then solves for
+    /// the control points near those patches alone, the others held, window by window (a block
+    /// Gauss–Seidel step on the new system). When the windows would cover much of the grid it
+    /// solves the whole updated system instead (a new factorisation, but no new assembly of
+    /// the points: that was a third of a solve's time at 10,000 control points).
     ///
     /// Why: the stiffening changes the solution only where it acts (the data pin the rest), and
     /// a window's factorisation costs a fraction of the whole grid's, which dominated the fit's
@@ -334,11 +336,6 @@ impl LsqSurfaceFitter {
         let changed: Vec<usize> = (0..after.len())
             .filter(|&i| after[i] != before[i])
             .collect();
-        let windows = stiffened_windows(grid, &changed, (nu, nv), (p, q));
-        let area: usize = windows.iter().map(|(r, c)| r.len() * c.len()).sum();
-        if area * WINDOW_SHARE > nu * nv {
-            return self.solve();
-        }
         let delta: Vec<[f64; 2]> = last
             .energy
             .iter()
@@ -346,6 +343,12 @@ impl LsqSurfaceFitter {
             .map(|(w, (b, a))| w.map(|x| x * (a - b)))
             .collect();
         system.add_energies(surface, grid, &delta, 1.0, 1.0);
+        let windows = stiffened_windows(grid, &changed, (nu, nv), (p, q));
+        let area: usize = windows.iter().map(|(r, c)| r.len() * c.len()).sum();
+        if area * WINDOW_SHARE > nu * nv {
+            let control = system.solve(last.rhs.clone())?;
+            return self.set_control(&control);
+        }
         let mut x = surface.control_points().to_vec();
         for (rows, cols) in windows {
             let mut sub = system.window(rows.clone(), cols.clone())?;
