@@ -232,6 +232,39 @@ fn msh_text_has_the_counted_blocks() {
     assert_eq!(*lines.last().unwrap(), "$EndElements");
 }
 
+/// A cubic × linear surface on an annulus sector of `degrees` (radii 1 and 2, u along the arc).
+fn sector(degrees: f64) -> BSplineSurface {
+    let n = 16;
+    let mut ctrl = Vec::new();
+    for i in 0..n {
+        let a = (degrees * i as f64 / (n - 1) as f64).to_radians();
+        for r in [1.0, 2.0] {
+            ctrl.push(Point3::new(r * a.cos(), r * a.sin(), 0.0));
+        }
+    }
+    let ku = KnotVector::clamped_uniform(3, n).unwrap();
+    let kv = KnotVector::clamped_uniform(1, 2).unwrap();
+    BSplineSurface::try_new(ku, kv, ctrl).unwrap()
+}
+
+#[test]
+fn elements_that_invert_on_a_regular_surface_are_halved_until_they_do_not() {
+    // One element asked for (edges of 100 units, no grading). Over a 90° sector it is a
+    // convex quad and stays one element; over 270° its corners span a quad turned against the
+    // surface, which never folds (the sector is flat, its normal +z everywhere), so the mesher
+    // halves it until no element inverts.
+    let options = FemOptions::default().with_edge(100.0).with_grading(0.0);
+    let q = *mesh_bspline(&sector(90.0), &options, None)
+        .unwrap()
+        .quality();
+    assert_eq!((q.elements, q.inverted), (1, 0), "{q:?}");
+    let q = *mesh_bspline(&sector(270.0), &options, None)
+        .unwrap()
+        .quality();
+    assert!(q.elements > 1 && q.elements <= 16, "{q:?}");
+    assert_eq!((q.inverted, q.on_folds), (0, 0), "{q:?}");
+}
+
 #[test]
 fn real_fits_mesh_without_inverting_where_the_surface_is_regular() {
     // bun000 (a range scan) fitted with one B-spline surface, the defaults.
@@ -243,9 +276,11 @@ fn real_fits_mesh_without_inverting_where_the_surface_is_regular() {
     let fem = mesh_fit(fit.as_ref(), &FemOptions::default().with_count(20_000)).unwrap();
     let q = *fem.quality();
     assert!((q.elements as f64 / 20_000.0 - 1.0).abs() < 0.03, "{q:?}");
-    // The least-squares fit stiffens the patches where it folds beside the data, so the mesh
-    // (trimmed to the data) has at most a couple of inverted elements (1 when measured; 51 of
-    // 20,000 before the fold guard).
+    // The least-squares fit stiffens the patches where it folds beside the data, and the mesher
+    // halves the elements that invert where the surface does not fold, so the mesh (trimmed to
+    // the data) has no inverted element off a fold and at most a couple on one (none when
+    // measured; 51 of 20,000 before the fold guard, 1 before the mend).
+    assert!(q.inverted_off_folds == 0, "{q:?}");
     assert!(q.inverted <= 2 && q.on_folds < 60, "{q:?}");
     assert!(q.aspect_mean < 5.0, "{q:?}");
     // Catmull–Clark fits: spot (a quad mesh) has no fold and no inverted element; suzanne

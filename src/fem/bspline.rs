@@ -2,7 +2,7 @@
 //! curvature, optionally trimmed by an inside test.
 
 use super::grading::{equidistribute, intervals, max_curvature, resolve_size};
-use super::{FemError, FemMesh, FemOptions, FemSize, MAX_ELEMENTS};
+use super::{quality, FemError, FemMesh, FemOptions, FemSize, MAX_ELEMENTS};
 use crate::geom::{Aabb, Point3, Vec3};
 use crate::spline::{BSplineSurface, KnotVector, TrimRegion, MAX_DEGREE};
 
@@ -30,9 +30,27 @@ pub fn mesh_bspline(
         }
         _ => (grid, kept),
     };
-    let (nodes, normals) = eval_grid(surface, &grid.us, &grid.vs);
+    let (mut grid, mut quads) = (grid, quads);
+    let (mut nodes, mut normals) = eval_grid(surface, &grid.us, &grid.vs);
+    for _ in 0..MEND_ROUNDS {
+        if !grid.split_inverted(&nodes, &normals, &quads) {
+            break;
+        }
+        quads = grid.quads(trim).0;
+        (nodes, normals) = eval_grid(surface, &grid.us, &grid.vs);
+    }
     FemMesh::assemble(nodes, normals, quads)
 }
+
+/// Rounds of [`Grid::split_inverted`]. Measured on the B-spline fits (defaults) of nine data
+/// and corpus files at 20,000 elements, inverted elements off folds in all: 131 without, 113
+/// after one round, 100 after two, 92 after three (bun000, rocker-arm, teapot and homer at 0;
+/// spot 24 → 6), 95 after five; what is left (fandisk 60, cow 32) lies beside folds the corner
+/// normals do not see, and more rounds only add elements there.
+const MEND_ROUNDS: usize = 3;
+
+/// [`Grid::split_inverted`] adds at most one element per this many in each direction and round.
+const MEND_SHARE: usize = 40;
 
 /// The u and v lines of a FEM mesh.
 struct Grid {
@@ -82,6 +100,60 @@ impl Grid {
             }
         }
         (quads, total)
+    }
+}
+
+impl Grid {
+    /// Halves, in both directions, the elements of `quads` that invert where the surface does
+    /// not fold (see [`quality::inverted_off_fold`]): the intervals holding most of them, each
+    /// direction adding at most 1/[`MEND_SHARE`] of the elements (one interval at least).
+    /// Returns whether any was split.
+    ///
+    /// Why: the lines follow the parameterisation, and where it shears hard within one
+    /// element the element's corners no longer span a convex quad in the tangent plane; half
+    /// the parameter step brings the element back to the surface's tangent plane. A new line
+    /// runs through the whole grid, so the mesh stays structured and conforming; the cap keeps
+    /// a surface with many such places (beside its folds) near the element count asked for.
+    fn split_inverted(&mut self, nodes: &[Point3], normals: &[Vec3], quads: &[[u32; 4]]) -> bool {
+        let nv = self.vs.len();
+        // Per interval of each direction: (inverted elements, elements) among `quads`.
+        let (mut cu, mut cv) = (vec![(0, 0); self.us.len()], vec![(0, 0); nv]);
+        for q in quads {
+            let (p, n) = (q.map(|k| nodes[k as usize]), q.map(|k| normals[k as usize]));
+            let bad = usize::from(quality::inverted_off_fold(p, n));
+            let c = q[0] as usize;
+            for x in [&mut cu[c / nv], &mut cv[c % nv]] {
+                *x = (x.0 + bad, x.1 + 1);
+            }
+        }
+        let budget = quads.len() / MEND_SHARE;
+        let split = |t: &mut Vec<f64>, count: &[(usize, usize)]| -> bool {
+            let mut worst: Vec<usize> = (0..count.len()).filter(|&i| count[i].0 > 0).collect();
+            worst.sort_by_key(|&i| (std::cmp::Reverse(count[i].0), i));
+            let mut at = vec![false; t.len()];
+            let mut added = 0;
+            for i in worst {
+                if added > 0 && added + count[i].1 > budget {
+                    break;
+                }
+                at[i] = true;
+                added += count[i].1;
+            }
+            let mut out = Vec::with_capacity(t.len() + 1);
+            for (i, w) in t.windows(2).enumerate() {
+                out.push(w[0]);
+                if at[i] {
+                    out.push(0.5 * (w[0] + w[1]));
+                }
+            }
+            out.extend(t.last());
+            let any = out.len() > t.len();
+            *t = out;
+            any
+        };
+        let u = split(&mut self.us, &cu);
+        let v = split(&mut self.vs, &cv);
+        u || v
     }
 }
 

@@ -45,6 +45,12 @@ fn across_fold(n: &[Vec3; 4]) -> bool {
     (0..4).any(|a| (a + 1..4).any(|b| n[a].dot(n[b]) < 0.0))
 }
 
+/// Whether the element at `p` with surface normals `n` inverts where the surface does not
+/// fold: the mesher's own failure, which smaller elements mend (across a fold none can).
+pub(super) fn inverted_off_fold(p: [Point3; 4], n: [Vec3; 4]) -> bool {
+    !across_fold(&n) && element(p, n).2 <= 0.0
+}
+
 /// The figures of one element: (aspect ratio, skew degrees, scaled Jacobian). The corner
 /// Jacobians are taken about the element's own normal (its diagonals' cross product, as
 /// Verdict does for quads in 3D), signed by whether that normal agrees with the surface
