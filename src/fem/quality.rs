@@ -41,14 +41,14 @@ pub struct FemQuality {
 }
 
 /// Whether the surface normals at an element's corners point against each other.
-fn across_fold(n: &[Vec3; 4]) -> bool {
+pub(super) fn across_fold(n: &[Vec3; 4]) -> bool {
     (0..4).any(|a| (a + 1..4).any(|b| n[a].dot(n[b]) < 0.0))
 }
 
-/// Whether the element at `p` with surface normals `n` inverts where the surface does not
-/// fold: the mesher's own failure, which smaller elements mend (across a fold none can).
-pub(super) fn inverted_off_fold(p: [Point3; 4], n: [Vec3; 4]) -> bool {
-    !across_fold(&n) && element(p, n).2 <= 0.0
+/// Whether the element at `p` with surface normals `n` at its corners is inverted (or
+/// degenerate): its scaled Jacobian is ≤ 0.
+pub(super) fn inverted(p: [Point3; 4], n: [Vec3; 4]) -> bool {
+    element(p, n).2 <= 0.0
 }
 
 /// The figures of one element: (aspect ratio, skew degrees, scaled Jacobian). The corner
