@@ -266,3 +266,97 @@ fn smooth_scans_with_a_few_creases_cost_no_more_control_points() {
         );
     }
 }
+
+/// A B-spline surface fit (least squares, defaults) of `mesh`, with or without creases.
+fn bspline_fit(mesh: &PolyMesh, creases: bool) -> Box<dyn geofit::fit::Fitter> {
+    let spec = FitSpec::new(Scheme::BsplineSurface).with_creases(creases);
+    let mut fit = spec.build(&FitData::points(mesh)).expect("the fit starts");
+    fit.run().expect("the fit runs");
+    fit
+}
+
+#[test]
+fn a_crease_along_a_parameter_line_becomes_a_c0_knot_line_of_a_bspline_surface() {
+    // A roof z = 0.6 |x − 23| over a 40 × 40 grid: a 62° crease along y.
+    let slope: f64 = 0.6;
+    let roof = common::meshes::tri_grid(40, |x, _| slope * (x - 23.0).abs());
+    let smooth = bspline_fit(&roof, false);
+    let sharp = bspline_fit(&roof, true);
+    let (s, k) = (
+        FitReport::of(smooth.as_ref()),
+        FitReport::of(sharp.as_ref()),
+    );
+    let knots = k
+        .creases
+        .as_ref()
+        .and_then(|c| c.knot_lines.clone())
+        .expect("knot lines");
+    assert_eq!((knots.knots.len(), knots.unaligned), (1, 0), "{knots:?}");
+    assert_eq!(k.status, FitStatus::Converged);
+    println!(
+        "roof: {} control points, E_max {:.5} % with the knot line; {}, {:.5} % without",
+        k.final_control_points, k.e_max_pct, s.final_control_points, s.e_max_pct
+    );
+    // The C0 line follows the crease: a tenth of the control points, and closer.
+    assert!(
+        k.final_control_points * 5 <= s.final_control_points,
+        "{} with the knot line, {} without",
+        k.final_control_points,
+        s.final_control_points
+    );
+    assert!(
+        k.e_max_pct < s.e_max_pct,
+        "{} vs {}",
+        k.e_max_pct,
+        s.e_max_pct
+    );
+    // Across the knot line the normal turns by the data's angle (≥ 0.8 of it) all along the
+    // crease.
+    let Some(geofit::fit::Spline::Surface { surface, params }) = sharp.spline() else {
+        panic!("a B-spline surface fit has a surface");
+    };
+    let knot = &knots.knots[0];
+    let d = usize::from(knot.direction == "v");
+    let along: Vec<f64> = roof
+        .positions()
+        .iter()
+        .zip(params)
+        .filter(|(p, _)| (p.x - 23.0).abs() < 1e-9 && p.y > 2.0 && p.y < 38.0)
+        .map(|(_, t)| t[1 - d])
+        .collect();
+    assert!(along.len() > 30, "{} crease points", along.len());
+    let data_angle = 2.0 * slope.atan();
+    for t in along {
+        let normal = |x: f64| {
+            let mut at = [t, t];
+            at[d] = x;
+            let der = surface.derivs(at[0], at[1], 1);
+            der.skl[1][0].cross(der.skl[0][1]).normalize()
+        };
+        let turn = normal(knot.at - 1e-3).angle_between(normal(knot.at + 1e-3));
+        assert!(
+            turn >= 0.8 * data_angle,
+            "{:.1}° of {:.1}° at {t}",
+            turn.to_degrees(),
+            data_angle.to_degrees()
+        );
+    }
+}
+
+#[test]
+fn a_crease_across_the_parameter_lines_is_reported_and_changes_nothing() {
+    // The same roof turned 45° in the grid (its crease along the triangles' diagonals
+    // x + y = 40): the crease runs diagonally in (u, v).
+    let roof = common::meshes::tri_grid(40, |x, y| 0.6 * (x + y - 40.0).abs() / 2f64.sqrt());
+    let smooth = FitReport::of(bspline_fit(&roof, false).as_ref());
+    let sharp = FitReport::of(bspline_fit(&roof, true).as_ref());
+    let creases = sharp.creases.expect("creases are reported");
+    assert!(creases.lines >= 1);
+    let knots = creases.knot_lines.expect("knot lines are reported");
+    assert_eq!(
+        (knots.knots.len(), knots.unaligned),
+        (0, creases.lines),
+        "{knots:?}"
+    );
+    assert_eq!(sharp.final_control_points, smooth.final_control_points);
+}

@@ -139,6 +139,12 @@ impl FitLog {
         self.creases.as_ref()
     }
 
+    /// Records the control-point count the fit starts from, when set-up changed it after the
+    /// log began (a B-spline surface's crease knots).
+    pub(crate) fn set_initial_control(&mut self, initial_control: usize) {
+        self.initial_control = initial_control;
+    }
+
     /// Records the sharp features found and kept.
     pub(crate) fn set_creases(&mut self, report: Option<CreaseReport>) {
         self.creases = report;
@@ -181,9 +187,16 @@ impl FitLog {
             }
         }
         if let Some(c) = self.creases.as_ref().filter(|c| c.edges > 0) {
+            let kept = match &c.knot_lines {
+                Some(k) => k.summary(),
+                None => format!(
+                    "{} crease edges tagged on the control mesh",
+                    c.control_edges
+                ),
+            };
             notes.push(format!(
-                "sharp features at {}°: {}; {} crease edges tagged on the control mesh",
-                c.angle_deg, c.summary, c.control_edges
+                "sharp features at {}°: {}; {kept}",
+                c.angle_deg, c.summary
             ));
         }
         notes

@@ -49,10 +49,10 @@ pub use subdiv::{
     ReconstructionReport, SubdivFitOptions, SubdivFitter, Weighting,
 };
 pub use surface::{
-    detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, FoldPolicy,
-    GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions,
-    ParamOptions, Parameterization, SectionsFitter, SectionsOptions, SurfaceGrid, SurfaceTrim,
-    TolMode,
+    detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, CreaseKnot,
+    CreaseKnots, FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter,
+    LsqSurfaceOptions, ParamOptions, Parameterization, SectionsFitter, SectionsOptions,
+    SurfaceGrid, SurfaceTrim, TolMode,
 };
 
 use crate::geom::Point3;

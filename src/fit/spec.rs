@@ -26,16 +26,17 @@
 
 use super::curve::{CurveFitOptions, CurveFitter, KnotPlacementFitter, KnotPlacementOptions};
 use super::strays::WithoutStrays;
-use super::subdiv::{build_subdiv_fitter, SubdivFitOptions, Weighting};
+use super::subdiv::{build_subdiv_fitter, find_creases, CreaseReport, SubdivFitOptions, Weighting};
 use super::surface::{
-    detect_rows, grid_rows, FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions,
-    LsqSurfaceFitter, LsqSurfaceOptions, SectionsFitter, SectionsOptions, SurfaceGrid, TolMode,
+    detect_rows, grid_rows, CreaseKnots, FoldPolicy, GeometricSurfaceFitter,
+    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, SectionsFitter, SectionsOptions,
+    SurfaceGrid, TolMode,
 };
 use super::{Acceleration, FitError, Fitter, Tolerances};
 use crate::cloud::{ReconstructOptions, SurfaceKind};
 use crate::geom::{Point3, Vec3};
 use crate::io::{LoadedFile, RangeGrid};
-use crate::mesh::{FeatureOptions, PolyMesh};
+use crate::mesh::{FeatureLine, FeatureOptions, PolyMesh};
 use crate::subdiv;
 use serde::{Deserialize, Serialize};
 use web_time::Instant;
@@ -274,11 +275,14 @@ pub struct FitSpec {
     /// B-spline surface, sections method: points per row of data without a range grid [rows
     /// start at every jump].
     pub rows: Option<usize>,
-    /// Subdivision: find the data's sharp creases and keep them sharp (QEM keeps them as edge
-    /// chains, the control mesh tags them, refinement carries them) [off: see docs/features.md
-    /// for why it is not yet the default].
+    /// Subdivision and B-spline surfaces (geometric, least squares): find the data's sharp
+    /// creases and keep them sharp (subdivision: QEM keeps them as edge chains, the control
+    /// mesh tags them, refinement carries them; B-spline surface: the lines that run along a
+    /// parameter line become C0 knot lines) [off: see docs/features.md for why it is not yet
+    /// the default].
     pub creases: bool,
-    /// Subdivision: dihedral angle above which a data edge is a crease, degrees [40].
+    /// Subdivision and B-spline surfaces: dihedral angle above which a data edge is a crease,
+    /// degrees [40].
     pub crease_angle: Option<f64>,
 }
 
@@ -492,14 +496,14 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
     info!(
         "creases",
         "creases",
-        &[LP, CC, DS],
+        &[LP, CC, DS, BS],
         &[GEO, LSQ],
         "keep the data's sharp creases sharp"
     ),
     info!(
         "creaseAngle",
         "crease-angle",
-        &[LP, CC, DS],
+        &[LP, CC, DS, BS],
         &[GEO, LSQ],
         "dihedral angle that makes a crease, degrees"
     ),
@@ -773,9 +777,13 @@ impl FitSpec {
                     self.subdiv_options(),
                 )?)
             }
-            (Scheme::BsplineSurface, Method::Geometric) => Box::new(
-                GeometricSurfaceFitter::try_new(points, self.geometric_surface_options())?,
-            ),
+            (Scheme::BsplineSurface, Method::Geometric) => {
+                let mut fitter =
+                    GeometricSurfaceFitter::try_new(points, self.geometric_surface_options())?;
+                let report = self.surface_creases(data.mesh, |l| fitter.keep_creases(l))?;
+                fitter.log_mut().set_creases(report);
+                Box::new(fitter)
+            }
             (Scheme::BsplineSurface, Method::Sections) => {
                 let (points, rows) = match data.grid {
                     Some(grid) => {
@@ -792,7 +800,10 @@ impl FitSpec {
                 )?)
             }
             (Scheme::BsplineSurface, _) => {
-                Box::new(LsqSurfaceFitter::try_new(points, self.lsq_options())?)
+                let mut fitter = LsqSurfaceFitter::try_new(points, self.lsq_options())?;
+                let report = self.surface_creases(data.mesh, |l| fitter.keep_creases(l))?;
+                fitter.log_mut().set_creases(report);
+                Box::new(fitter)
             }
             (_, method) => {
                 let (points, file_closed) = data.curve_points();
@@ -863,6 +874,26 @@ impl FitSpec {
             refine_growth: self.refine_growth.unwrap_or(d.refine_growth),
             ..d
         }
+    }
+
+    /// With [`FitSpec::creases`], the creases of `mesh` (the data) found and handed to `keep`,
+    /// a B-spline surface fitter's `keep_creases`, and the report of both.
+    fn surface_creases(
+        &self,
+        mesh: &PolyMesh,
+        keep: impl FnOnce(&[FeatureLine]) -> CreaseKnots,
+    ) -> Result<Option<CreaseReport>, FitError> {
+        let Some((angle, found)) = find_creases(mesh, self.feature_options().as_ref())? else {
+            return Ok(None);
+        };
+        let knots = keep(&found.lines);
+        Ok(Some(CreaseReport::of(
+            angle,
+            &found,
+            mesh.positions(),
+            0,
+            Some(knots),
+        )))
     }
 
     /// How the data's creases are found, or `None` when [`FitSpec::creases`] is off.

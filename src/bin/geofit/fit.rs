@@ -130,12 +130,12 @@ pub struct Args {
     /// row starts at every jump; a range scan's rows are its grid's).
     #[arg(long)]
     rows: Option<usize>,
-    /// Subdivision: find the data's sharp creases and keep them sharp (QEM keeps them as edge
-    /// chains of the control mesh, which tags them as creases).
+    /// Subdivision and B-spline surfaces: find the data's sharp creases and keep them sharp
+    /// (subdivision: QEM keeps them as edge chains of the control mesh, which tags them as
+    /// creases; B-spline surface: creases that run along a parameter line become C0 knot lines)
     #[arg(long)]
     creases: bool,
-    /// Subdivision, with --creases: dihedral angle above which a data edge is a crease,
-    /// degrees.
+    /// With --creases: dihedral angle above which a data edge is a crease, degrees.
     #[arg(long)]
     crease_angle: Option<f64>,
     /// Write the report (set-up, final errors, times, per-iteration history) as JSON.

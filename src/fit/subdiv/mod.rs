@@ -10,6 +10,7 @@ mod setup;
 pub use control::surface_of;
 pub use options::{SubdivFitOptions, Weighting};
 pub(crate) use setup::build_subdiv_fitter;
+pub(crate) use setup::find_creases;
 pub use setup::{default_initial_count, initial_control, CreaseReport, ReconstructionReport};
 
 use super::accel::Accelerator;

@@ -3,12 +3,13 @@
 
 use super::{SubdivFitOptions, SubdivFitter};
 use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
+use crate::fit::surface::CreaseKnots;
 use crate::fit::{DataSurface, FitError, Fitter};
 use crate::geom::Point3;
 use crate::io::RangeGrid;
 use crate::mesh::{
-    detect_features, simplify_with_creases, FeatureOptions, PolyMesh, Simplified, SimplifyOptions,
-    SimplifyReport,
+    detect_features, simplify_with_creases, FeatureOptions, Features, PolyMesh, Simplified,
+    SimplifyOptions, SimplifyReport,
 };
 use crate::subdiv::{Scheme, SubdivSurface};
 use serde::Serialize;
@@ -42,14 +43,7 @@ pub fn initial_control(
     let used = used_vertices(data);
     let given = target;
     let target = target.unwrap_or_else(|| default_initial_count(data.num_vertices(), used));
-    // Detection fails only on options FitSpec has validated already.
-    let found = features
-        .map(|f| detect_features(data, f).map(|found| (f.angle_deg, found)))
-        .transpose()
-        .map_err(|e| FitError::InvalidOption {
-            name: "creaseAngle",
-            reason: e.to_string(),
-        })?;
+    let found = find_creases(data, features)?;
     let edges = found.as_ref().map_or(&[][..], |(_, f)| f.edges.as_slice());
     let options = SimplifyOptions::default();
     let mut simplified = simplify_with_creases(data, target, &options, edges)?;
@@ -69,22 +63,31 @@ pub fn initial_control(
         let more = (target + extra).min(used);
         simplified = simplify_with_creases(data, more, &options, edges)?;
     }
-    let report = found.map(|(angle_deg, f)| CreaseReport {
-        segments: f
-            .edges
-            .iter()
-            .flat_map(|e| e.map(|v| data.positions()[v as usize]))
-            .collect(),
-        angle_deg,
-        summary: f.summary(),
-        edges: f.edges.len(),
-        lines: f.lines.len(),
-        corners: f.corners.len(),
-        darts: f.darts.len(),
-        length: f.total_length,
-        control_edges: simplified.creases.len(),
+    let report = found.map(|(angle_deg, f)| {
+        CreaseReport::of(
+            angle_deg,
+            &f,
+            data.positions(),
+            simplified.creases.len(),
+            None,
+        )
     });
     Ok((simplified, report))
+}
+
+/// The sharp features of `data` with the angle they were found at, when `features` asks for
+/// them. Detection fails only on options FitSpec has validated already.
+pub(crate) fn find_creases(
+    data: &PolyMesh,
+    features: Option<&FeatureOptions>,
+) -> Result<Option<(f64, Features)>, FitError> {
+    features
+        .map(|f| detect_features(data, f).map(|found| (f.angle_deg, found)))
+        .transpose()
+        .map_err(|e| FitError::InvalidOption {
+            name: "creaseAngle",
+            reason: e.to_string(),
+        })
 }
 
 /// The share of the default initial count above which the vertices QEM keeps on crease lines
@@ -118,12 +121,44 @@ pub struct CreaseReport {
     pub darts: usize,
     /// Total length of the crease edges, model units.
     pub length: f64,
-    /// Crease edges tagged sharp on the initial control mesh.
+    /// Crease edges tagged sharp on the initial control mesh (0 for a B-spline surface).
     pub control_edges: usize,
+    /// A B-spline surface's crease knot lines: which crease lines it could represent.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub knot_lines: Option<CreaseKnots>,
     /// The crease edges of the data as line segments (both ends of each), for drawing; not
     /// written to JSON.
     #[serde(skip)]
     pub segments: Vec<Point3>,
+}
+
+impl CreaseReport {
+    /// The report of `features` found at `angle_deg` on the points `positions`, with what the
+    /// fit made of them: crease edges of the control mesh, or a B-spline surface's knot lines.
+    pub(crate) fn of(
+        angle_deg: f64,
+        features: &Features,
+        positions: &[Point3],
+        control_edges: usize,
+        knot_lines: Option<CreaseKnots>,
+    ) -> CreaseReport {
+        CreaseReport {
+            segments: features
+                .edges
+                .iter()
+                .flat_map(|e| e.map(|v| positions[v as usize]))
+                .collect(),
+            angle_deg,
+            summary: features.summary(),
+            edges: features.edges.len(),
+            lines: features.lines.len(),
+            corners: features.corners.len(),
+            darts: features.darts.len(),
+            length: features.total_length,
+            control_edges,
+            knot_lines,
+        }
+    }
 }
 
 /// What [`build_subdiv_fitter`] made of bare points before simplifying: goes into the fit

@@ -76,16 +76,18 @@ impl Stiffness {
     /// is left so.
     ///
     /// Why not the others: where no point is near, the surface is the smoothing energy's
-    /// minimiser alone, whatever its weight, so raising it changes nothing there.
+    /// minimiser alone, whatever its weight, so raising it changes nothing there. `c0` are the
+    /// crease knot lines ([u, v]), where the normal may turn at once (see [`folded_patches`]).
     pub(crate) fn stiffen_folds(
         &mut self,
         surface: &BSplineSurface,
         grid: &PatchGrid,
         held: &[usize],
+        c0: &[Vec<f64>; 2],
     ) -> usize {
         let (nu, nv) = (grid.u.len(), grid.v.len());
         let near_data = |i: usize| neighbours(i, nu, nv).any(|k| held[k] > 0);
-        let mut folded = folded_patches(surface, grid);
+        let mut folded = folded_patches(surface, grid, c0);
         for (i, f) in folded.iter_mut().enumerate() {
             *f = *f && near_data(i);
         }
@@ -137,8 +139,14 @@ fn centres(surface: &BSplineSurface, grid: &PatchGrid, along_u: bool) -> Vec<f64
 }
 
 /// Which patches fold: the normals S_u × S_v at two neighbouring samples (the corners and
-/// middles of the spans) point against each other, or one of them vanishes.
-pub(crate) fn folded_patches(surface: &BSplineSurface, grid: &PatchGrid) -> Vec<bool> {
+/// middles of the spans) point against each other, or one of them vanishes. Two samples on
+/// either side of (or on) a crease knot line of `c0` ([u values, v values]) are not compared:
+/// there the surface is C0 on purpose, and a crease sharper than a right angle is not a fold.
+pub(crate) fn folded_patches(
+    surface: &BSplineSurface,
+    grid: &PatchGrid,
+    c0: &[Vec<f64>; 2],
+) -> Vec<bool> {
     let lines = |along_u: bool| -> Vec<f64> {
         let b = boundaries(surface, grid, along_u);
         let mut t: Vec<f64> = b
@@ -158,12 +166,18 @@ pub(crate) fn folded_patches(surface: &BSplineSurface, grid: &PatchGrid) -> Vec<
     let mut folded = vec![false; nu * nv];
     let mut mark =
         |i: usize, j: usize| folded[(i / m).min(nu - 1) * nv + (j / m).min(nv - 1)] = true;
+    let smooth = |t: &[f64], k: usize, lines: &[f64]| {
+        k + 1 < t.len() && !lines.iter().any(|&c| t[k] <= c && c <= t[k + 1])
+    };
+    let (smooth_u, smooth_v): (Vec<bool>, Vec<bool>) = (
+        (0..us.len()).map(|i| smooth(&us, i, &c0[0])).collect(),
+        (0..vs.len()).map(|j| smooth(&vs, j, &c0[1])).collect(),
+    );
     for i in 0..us.len() {
         for j in 0..vs.len() {
             let a = n(i, j);
             let turns = |b: Vec3| a.dot(b) <= 0.0;
-            if (i + 1 < us.len() && turns(n(i + 1, j))) || (j + 1 < vs.len() && turns(n(i, j + 1)))
-            {
+            if (smooth_u[i] && turns(n(i + 1, j))) || (smooth_v[j] && turns(n(i, j + 1))) {
                 mark(i, j);
             }
         }
@@ -262,15 +276,38 @@ mod tests {
     fn a_plane_has_no_fold_and_a_surface_running_back_over_itself_has() {
         let flat = plane(8, None);
         let grid = PatchGrid::of(&flat);
-        assert!(folded_patches(&flat, &grid).iter().all(|f| !f));
+        assert!(folded_patches(&flat, &grid, &NONE).iter().all(|f| !f));
         let folded = plane(8, Some(4));
-        let marks = folded_patches(&folded, &PatchGrid::of(&folded));
+        let marks = folded_patches(&folded, &PatchGrid::of(&folded), &NONE);
         let count = marks.iter().filter(|f| **f).count();
         assert!(
             count > 0 && count < marks.len() / 4,
             "{count} of {}",
             marks.len()
         );
+    }
+
+    /// No crease knot lines.
+    const NONE: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+
+    #[test]
+    fn a_crease_knot_line_sharper_than_a_right_angle_is_not_a_fold() {
+        // z = 3 |x − 1/2| with a C0 knot line at u = 1/2: the normals on its two sides are
+        // 143° apart. Exact, since the spline reproduces each linear side.
+        let mut s = plane(8, None);
+        for _ in 0..3 {
+            s.insert_knot_u(0.5).unwrap();
+        }
+        let control: Vec<Point3> = s
+            .control_points()
+            .iter()
+            .map(|c| Point3::new(c.x, c.y, 3.0 * (c.x - 0.5).abs()))
+            .collect();
+        s.set_control_points(&control).unwrap();
+        let grid = PatchGrid::of(&s);
+        assert!(folded_patches(&s, &grid, &NONE).iter().any(|f| *f));
+        let c0 = [vec![0.5], Vec::new()];
+        assert!(folded_patches(&s, &grid, &c0).iter().all(|f| !f));
     }
 
     #[test]
@@ -299,21 +336,27 @@ mod tests {
         let mut s = plane(8, Some(4));
         let grid = PatchGrid::of(&s);
         let mut stiffness = Stiffness::default();
-        assert_eq!(stiffness.stiffen_folds(&s, &grid, &vec![0; grid.len()]), 0);
+        assert_eq!(
+            stiffness.stiffen_folds(&s, &grid, &vec![0; grid.len()], &NONE),
+            0
+        );
         assert!(stiffness.factors(&s, &grid).iter().all(|f| *f == 1.0));
-        let raised = stiffness.stiffen_folds(&s, &grid, &vec![1; grid.len()]);
+        let raised = stiffness.stiffen_folds(&s, &grid, &vec![1; grid.len()], &NONE);
         assert!(raised > 0);
         let before = stiffness.factors(&s, &grid);
         assert!(before.contains(&STIFF) && before.contains(&1.0));
         // Stiff already: a second check raises nothing; once relaxed, it raises them again.
-        assert_eq!(stiffness.stiffen_folds(&s, &grid, &vec![1; grid.len()]), 0);
+        assert_eq!(
+            stiffness.stiffen_folds(&s, &grid, &vec![1; grid.len()], &NONE),
+            0
+        );
         stiffness.relax();
         let relaxed = stiffness.factors(&s, &grid);
         for (r, b) in relaxed.iter().zip(&before) {
             assert_eq!(*r, (b / RELAX).max(1.0));
         }
         assert_eq!(
-            stiffness.stiffen_folds(&s, &grid, &vec![1; grid.len()]),
+            stiffness.stiffen_folds(&s, &grid, &vec![1; grid.len()], &NONE),
             raised
         );
         assert_eq!(stiffness.factors(&s, &grid), before);

@@ -383,7 +383,7 @@ impl LsqSurfaceFitter {
         let before = self.stiffness.factors(&self.fit.surface, &grid);
         if self
             .stiffness
-            .stiffen_folds(&self.fit.surface, &grid, &held)
+            .stiffen_folds(&self.fit.surface, &grid, &held, &self.fit.c0)
             == 0
         {
             return Ok(());

@@ -22,6 +22,13 @@ macro_rules! surface_accessors {
         pub fn parameters(&self) -> &[[f64; 2]] {
             &self.fit.uv
         }
+
+        /// Makes the data's crease `lines` (vertex = point index) that run along a parameter
+        /// line of the surface C0 knot lines (see [`CreaseKnots`]); call it before the first
+        /// step. Returns which lines it could represent.
+        pub fn keep_creases(&mut self, lines: &[crate::mesh::FeatureLine]) -> super::CreaseKnots {
+            self.fit.keep_creases(&self.opts.grid, lines)
+        }
     };
 }
 
@@ -79,6 +86,7 @@ macro_rules! surface_fitter_methods {
     };
 }
 
+mod creases;
 mod folds;
 mod geometric;
 mod least_squares;
@@ -88,6 +96,7 @@ mod patches;
 mod sections;
 mod trim;
 
+pub use creases::{CreaseKnot, CreaseKnots};
 pub use geometric::{GeometricSurfaceFitter, GeometricSurfaceOptions};
 pub use least_squares::{energies, LsqSurfaceFitter, LsqSurfaceOptions};
 pub use parameterize::{
@@ -113,6 +122,8 @@ pub(crate) struct SurfaceFit {
     pub(crate) uv: Vec<[f64; 2]>,
     pub(crate) num_folded: usize,
     pub(crate) surface: BSplineSurface,
+    /// The crease knot lines ([u values, v values]) where the surface is C0 on purpose.
+    pub(crate) c0: [Vec<f64>; 2],
 }
 
 impl SurfaceFit {
@@ -142,7 +153,28 @@ impl SurfaceFit {
             uv: param.uv,
             num_folded: param.num_folded,
             surface,
+            c0: [Vec::new(), Vec::new()],
         }
+    }
+
+    /// See `keep_creases` of the fitters: the lines within `grid`'s tolerance of a parameter
+    /// line at the current parameters become knots of multiplicity p. Knot insertion keeps
+    /// the surface as it is, so the errors stay valid; the log's initial control-point count
+    /// is the new one.
+    pub(crate) fn keep_creases(
+        &mut self,
+        grid: &SurfaceGrid,
+        lines: &[crate::mesh::FeatureLine],
+    ) -> CreaseKnots {
+        let tol = grid.criterion(self.state.diagonal()).tol;
+        let data = (self.uv.as_slice(), self.state.data());
+        let knots = creases::find_crease_knots(&self.surface, lines, data, tol);
+        let [u, v] = creases::insert_crease_knots(&mut self.surface, &knots);
+        self.c0[0].extend(u);
+        self.c0[1].extend(v);
+        let n = self.surface.control_points().len();
+        self.state.log_mut().set_initial_control(n);
+        knots
     }
 
     /// Parameter correction: every point's foot point by `iterations` warm-started Newton
