@@ -7,7 +7,10 @@ use crate::geom::{Aabb, Point3, Vec3};
 use crate::spline::{BSplineSurface, KnotVector, TrimRegion, MAX_DEGREE};
 
 /// The FEM quad mesh of `surface` (see the [module](super) docs). `trim`, when given, trims
-/// it: elements whose four corners are all outside the region are dropped. A count asks for that
+/// it: elements whose four corners are all outside the region are dropped, and so are the
+/// elements across its outline that are inverted (part of them lies past the data, where the
+/// surface extrapolates and folds most often; an inverted element there is a fold the data
+/// never held, and leaving it out keeps the mesh valid). A count asks for that
 /// many elements inside: the lines are laid out once for the whole domain, then once more with
 /// the count scaled by the share of elements the trim kept (a second pass only when it dropped
 /// some), so a trimmed mesh is about as fine as the count says, not coarser by the trim.
@@ -38,6 +41,13 @@ pub fn mesh_bspline(
         }
         quads = grid.quads(trim).0;
         (nodes, normals) = eval_grid(surface, &grid.us, &grid.vs);
+    }
+    if let Some(region) = trim {
+        let inside = region.contains_grid(&grid.us, &grid.vs);
+        quads.retain(|q| {
+            q.iter().all(|&c| inside[c as usize])
+                || !quality::inverted(q.map(|k| nodes[k as usize]), q.map(|k| normals[k as usize]))
+        });
     }
     FemMesh::assemble(nodes, normals, quads)
 }
@@ -328,6 +338,23 @@ mod tests {
         let (_, normals) = eval_grid(s, &grid.us, &grid.vs);
         let n = [0, 2, 3, 1].map(|k| normals[k]);
         grid.mendable(s, 0, &n)
+    }
+
+    #[test]
+    fn inverted_elements_across_the_trim_outline_are_dropped() {
+        // The sheet of the test below that runs out along x and back, folded at u = 1/2,
+        // trimmed to u < 1/2: the elements across the outline hold the fold (6 of them invert
+        // when kept).
+        let folded = surface(|s, t| Point3::new(1.0 - s * s, t, 0.0));
+        let options = FemOptions::default().with_count(400).with_grading(0.0);
+        let whole = mesh_bspline(&folded, &options, None).unwrap();
+        assert!(whole.quality().inverted > 0, "{:?}", whole.quality());
+        let outline = vec![[0.0, 0.0], [0.5, 0.0], [0.5, 1.0], [0.0, 1.0]];
+        let region = TrimRegion::try_new(outline, Vec::new()).unwrap();
+        let trimmed = mesh_bspline(&folded, &options, Some(&region)).unwrap();
+        let q = trimmed.quality();
+        assert_eq!(q.inverted, 0, "{q:?}");
+        assert!(q.elements > 150, "{q:?}");
     }
 
     #[test]
