@@ -200,6 +200,11 @@ fn cli_fit_scheme_bspline_writes_the_report() {
             vec!["--scheme", "bspline", "--tol-avg", "0.01"],
             "--tol-avg does not apply to --scheme bspline",
         ),
+        (
+            vec!["--scheme", "bspline", "--method", "sections", "--creases"],
+            "--creases does not apply to --scheme bspline-surface --method sections (with \
+             --scheme bspline-surface it applies to --method least-squares, geometric)",
+        ),
     ] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_geofit"))
             .arg("fit")

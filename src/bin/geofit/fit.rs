@@ -346,6 +346,24 @@ impl Args {
 /// A spec error in the command line's words: flags, not field names.
 fn cli_error(e: FitError) -> String {
     match e {
+        FitError::NotApplicable {
+            name,
+            scheme,
+            method: Some(method),
+        } => {
+            let info = OPTION_TABLE.iter().find(|o| o.name == name);
+            let methods: Vec<String> = scheme
+                .methods()
+                .iter()
+                .filter(|m| info.is_some_and(|o| o.applies(scheme, **m)))
+                .map(|m| m.to_string())
+                .collect();
+            format!(
+                "--{} does not apply to --scheme {scheme} --method {method} (with --scheme {scheme} it applies to --method {})",
+                flag_of(name),
+                methods.join(", ")
+            )
+        }
         FitError::NotApplicable { name, scheme, .. } => {
             let info = OPTION_TABLE.iter().find(|o| o.name == name);
             let schemes: Vec<&str> = Scheme::ALL
