@@ -45,11 +45,11 @@ mod open;
 
 pub use error::ReconstructError;
 
-use crate::geom::{Point3, Vec3};
+use crate::geom::{median, Point3, Vec3};
 use crate::io::RangeGrid;
 use crate::mesh::PolyMesh;
 use crate::mesh::{simplify_with, SimplifyOptions};
-use neighbours::{median, Neighbours};
+use neighbours::Neighbours;
 
 /// Which kind of surface the points sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

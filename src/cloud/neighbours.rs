@@ -46,14 +46,3 @@ impl Neighbours {
             .collect()
     }
 }
-
-/// The median of `values` (0 for none).
-pub(super) fn median(values: &[f64]) -> f64 {
-    let mut v: Vec<f64> = values.to_vec();
-    if v.is_empty() {
-        return 0.0;
-    }
-    let mid = v.len() / 2;
-    v.select_nth_unstable_by(mid, f64::total_cmp);
-    v[mid]
-}

@@ -5,7 +5,7 @@
 //! points — a reflection metres behind the object, a "no return" marker — that multiply the
 //! diagonal and so loosen every tolerance by the same factor, while the fit reports success.
 
-use super::Point3;
+use super::{quantile, Point3};
 
 /// The largest coordinate magnitude geofit takes: the largest an `f32` holds (3.4e38), since
 /// the page renders, and GLB and STL store, positions as `f32`. Inside it the fit's maths stays
@@ -93,13 +93,6 @@ pub fn find_strays(points: &[Point3]) -> Vec<u32> {
 fn median(points: &[Point3]) -> Point3 {
     let axis = |k: usize| quantile(&points.iter().map(|p| p[k]).collect::<Vec<_>>(), 0.5);
     Point3::new(axis(0), axis(1), axis(2))
-}
-
-/// The value of rank `share × (n − 1)` (rounded down) of `values` (non-empty).
-fn quantile(values: &[f64], share: f64) -> f64 {
-    let mut v = values.to_vec();
-    let rank = ((v.len() - 1) as f64 * share) as usize;
-    *v.select_nth_unstable_by(rank, f64::total_cmp).1
 }
 
 #[cfg(test)]

@@ -5,11 +5,13 @@ mod aabb;
 mod coords;
 mod eigen;
 mod nearest;
+mod order;
 
 pub use aabb::Aabb;
 pub use coords::{check_coordinates, find_strays, BadCoordinate, COORDINATE_LIMIT};
 pub use eigen::symmetric_eigen;
 pub use nearest::{ClosestPoint, Nearest, NewtonOptions};
+pub(crate) use order::{median, quantile};
 
 /// A point in 3D space (f64). An alias of glam's `DVec3`, so points and vectors share maths.
 pub type Point3 = glam::DVec3;

@@ -3,7 +3,7 @@
 //! least-squares problem min Σ_i ‖p_i − S(t_i)‖² over control-point moves, with a fairness term
 //! on the control net that holds the control points few data points pull on.
 
-use crate::geom::{Point3, Vec3};
+use crate::geom::{median, Point3, Vec3};
 use crate::mesh::PolyMesh;
 use crate::subdiv::{LimitSurface, SurfaceParam};
 
@@ -285,14 +285,3 @@ impl Stencils {
 /// Support (Σ_i B_ij² over the data) below this share of the median is weak: see
 /// [`Stencils::cg`].
 const WEAK_SUPPORT: f64 = 0.01;
-
-/// The median of `values` (0 for none).
-fn median(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let mut v = values.to_vec();
-    let mid = v.len() / 2;
-    let (_, m, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
-    *m
-}

@@ -10,7 +10,7 @@
 //! Away from the crease the kink is free, not forced: the data on both sides pin the surface,
 //! and the smoothing energies, integrated span by span, do not see the C0 line.
 
-use crate::geom::Point3;
+use crate::geom::{quantile, Point3};
 use crate::mesh::FeatureLine;
 use crate::spline::BSplineSurface;
 use serde::Serialize;
@@ -79,7 +79,7 @@ pub(crate) fn find_crease_knots(
         let along = [(0, "u", (u0, u1)), (1, "v", (v0, v1))]
             .into_iter()
             .filter_map(|(d, name, (lo, hi))| {
-                let c = median(params.iter().map(|p| p[d]).collect())?;
+                let c = lower_median(&params.iter().map(|p| p[d]).collect::<Vec<_>>())?;
                 let inside = c > lo + 1e-9 * (hi - lo) && c < hi - 1e-9 * (hi - lo);
                 let off = reach(surface, &params, d, c);
                 (inside && off <= tol && two_sided(surface, &on_line, (uv, points), d, c, tol))
@@ -203,12 +203,9 @@ fn reach(surface: &BSplineSurface, params: &[[f64; 2]], d: usize, c: f64) -> f64
 }
 
 /// The median of `values` (the lower one of an even count); `None` when empty or not finite.
-fn median(mut values: Vec<f64>) -> Option<f64> {
-    if values.is_empty() || values.iter().any(|x| !x.is_finite()) {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    Some(values[(values.len() - 1) / 2])
+fn lower_median(values: &[f64]) -> Option<f64> {
+    let finite = !values.is_empty() && values.iter().all(|x| x.is_finite());
+    finite.then(|| quantile(values, 0.5))
 }
 
 /// Inserts every knot of `knots` into `surface` until it has multiplicity = the degree there
