@@ -127,10 +127,13 @@ pub struct LsqSurfaceFitter {
 }
 
 /// The right-hand side of the last full solve and its per-patch energy weights (β2 and β3
-/// included, before the stiffness factors).
+/// included, before the stiffness factors), with the patch grid and the points per patch they
+/// were made for (the fold check's too).
 struct LastSolve {
     rhs: Mat<f64>,
     energy: Vec<[f64; 2]>,
+    grid: PatchGrid,
+    held: Vec<usize>,
 }
 
 /// Control points beyond a stiffened patch's own that its window frees, per side: two patch
@@ -273,14 +276,8 @@ impl LsqSurfaceFitter {
         let mut rhs = Mat::<f64>::zeros(nu * nv, 3);
         let count = system.add_points(surface, self.fit.samples(), &mut rhs);
         let grid = PatchGrid::of(surface);
-        let mut weights = patch_weights(
-            surface,
-            &grid,
-            &self.fit.uv,
-            &self.fit.active,
-            count,
-            self.ref_cell_area,
-        );
+        let held = patch_counts(surface, &grid, &self.fit.uv, &self.fit.active);
+        let mut weights = patch_weights(surface, &grid, &held, count, self.ref_cell_area);
         let scale = count.max(1) as f64;
         let (b2, b3) = (self.opts.beta2 * scale, self.opts.beta3 * scale);
         for w in weights.iter_mut() {
@@ -297,6 +294,8 @@ impl LsqSurfaceFitter {
         self.last = Some(LastSolve {
             rhs: rhs.clone(),
             energy: weights,
+            grid,
+            held,
         });
         let control = system.solve(rhs)?;
         self.set_control(&control)
@@ -378,8 +377,10 @@ impl LsqSurfaceFitter {
         if self.opts.beta2 == 0.0 && self.opts.beta3 == 0.0 {
             return Ok(());
         }
-        let grid = PatchGrid::of(&self.fit.surface);
-        let held = patch_counts(&self.fit.surface, &grid, &self.fit.uv, &self.fit.active);
+        let Some(last) = self.last.as_mut() else {
+            return Ok(());
+        };
+        let (grid, held) = (last.grid.clone(), std::mem::take(&mut last.held));
         let before = self.stiffness.factors(&self.fit.surface, &grid);
         if self
             .stiffness
@@ -447,7 +448,7 @@ impl Fitter for LsqSurfaceFitter {
 /// The factors of β2 and β3 of every patch: 1/ρ and ρ (SPEC §2), with ρ the relative point
 /// density (points per parameter area over points per domain area, kept within [1/64, 64] so
 /// empty patches get a finite weight), times s² and s³ for s = the patch's parameter area over
-/// `ref_area` (at most 1).
+/// `ref_area` (at most 1); `counts` are the points of the fit per patch.
 ///
 /// Why s: a feature that a patch of width h must follow has S_uu ~ 1/h² and S_uuu ~ 1/h³, so
 /// against the data term of the patch's points the thin-plate energy grows like 1/h⁴ and the
@@ -458,12 +459,10 @@ impl Fitter for LsqSurfaceFitter {
 fn patch_weights(
     surface: &BSplineSurface,
     grid: &PatchGrid,
-    uv: &[[f64; 2]],
-    active: &[bool],
+    counts: &[usize],
     count: usize,
     ref_area: f64,
 ) -> Vec<[f64; 2]> {
-    let counts = patch_counts(surface, grid, uv, active);
     let ((u0, u1), (v0, v1)) = surface.domain();
     let area = (u1 - u0) * (v1 - v0);
     let (ku, kv) = (surface.knots_u().knots(), surface.knots_v().knots());
