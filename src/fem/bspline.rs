@@ -22,28 +22,29 @@ pub fn mesh_bspline(
     options.validate()?;
     let field = SizeField::sample(surface);
     let grid = Grid::lay_out(surface, &field, options, options.size)?;
-    let (kept, total) = grid.quads(trim);
+    let inside = grid.inside(trim);
+    let (kept, total) = grid.quads(inside.as_deref());
     let share = kept.len() as f64 / total.max(1) as f64;
-    let (grid, quads) = match options.size {
+    let (mut grid, mut inside, mut quads) = match options.size {
         FemSize::Count(n) if share > 0.0 && share < 1.0 => {
             let scaled = ((n as f64 / share).round() as usize).min(MAX_ELEMENTS);
             let grid = Grid::lay_out(surface, &field, options, FemSize::Count(scaled))?;
-            let (quads, _) = grid.quads(trim);
-            (grid, quads)
+            let inside = grid.inside(trim);
+            let (quads, _) = grid.quads(inside.as_deref());
+            (grid, inside, quads)
         }
-        _ => (grid, kept),
+        _ => (grid, inside, kept),
     };
-    let (mut grid, mut quads) = (grid, quads);
     let (mut nodes, mut normals) = eval_grid(surface, &grid.us, &grid.vs);
     for _ in 0..MEND_ROUNDS {
         if !grid.split_inverted(surface, &nodes, &normals, &quads) {
             break;
         }
-        quads = grid.quads(trim).0;
+        inside = grid.inside(trim);
+        quads = grid.quads(inside.as_deref()).0;
         (nodes, normals) = eval_grid(surface, &grid.us, &grid.vs);
     }
-    if let Some(region) = trim {
-        let inside = region.contains_grid(&grid.us, &grid.vs);
+    if let Some(inside) = inside {
         quads.retain(|q| {
             q.iter().all(|&c| inside[c as usize])
                 || !quality::inverted(q.map(|k| nodes[k as usize]), q.map(|k| normals[k as usize]))
@@ -92,21 +93,22 @@ impl Grid {
         })
     }
 
-    /// The quads `trim` keeps (all without one; node `(i, j)` is `i * vs.len() + j`), and
-    /// how many there are in all.
-    fn quads(&self, trim: Option<&TrimRegion>) -> (Vec<[u32; 4]>, usize) {
+    /// Which nodes lie inside `trim` (node `(i, j)` at `i * vs.len() + j`); `None` without one.
+    fn inside(&self, trim: Option<&TrimRegion>) -> Option<Vec<bool>> {
+        trim.map(|r| r.contains_grid(&self.us, &self.vs))
+    }
+
+    /// The quads with a node `inside` (all without a mask; node `(i, j)` is
+    /// `i * vs.len() + j`), and how many there are in all.
+    fn quads(&self, inside: Option<&[bool]>) -> (Vec<[u32; 4]>, usize) {
         let nv = self.vs.len();
         let id = |i: usize, j: usize| (i * nv + j) as u32;
-        let keep = trim.map(|r| r.contains_grid(&self.us, &self.vs));
         let total = (self.us.len() - 1) * (nv - 1);
         let mut quads = Vec::with_capacity(total);
         for i in 0..self.us.len() - 1 {
             for j in 0..nv - 1 {
                 let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
-                if keep
-                    .as_ref()
-                    .is_none_or(|k| q.iter().any(|&c| k[c as usize]))
-                {
+                if inside.is_none_or(|k| q.iter().any(|&c| k[c as usize])) {
                     quads.push(q);
                 }
             }
