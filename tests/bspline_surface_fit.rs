@@ -4,8 +4,9 @@
 mod common;
 
 use geofit::fit::{
-    Acceleration, FitError, FitStatus, Fitter, GeometricSurfaceFitter, GeometricSurfaceOptions,
-    LsqSurfaceFitter, LsqSurfaceOptions, ParamOptions, TolMode,
+    Acceleration, FitData, FitError, FitReport, FitSpec, FitStatus, Fitter, GeometricSurfaceFitter,
+    GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, Method, ParamOptions, Scheme,
+    TolMode,
 };
 use geofit::geom::{Point3, Vec3};
 
@@ -247,4 +248,49 @@ fn a_mostly_failing_knot_vector_is_split_early() {
         .err()
         .expect("rejected");
     assert!(err.to_string().contains("early_split_share"), "{err}");
+}
+
+/// A B-spline surface fit of `data` by `method` with the defaults, run to its end, and its
+/// report.
+fn surface_report(data: &geofit::mesh::PolyMesh, method: Method) -> FitReport {
+    let spec = FitSpec::new(Scheme::BsplineSurface).with_method(Some(method));
+    let mut fit = spec.build(&FitData::points(data)).expect("the fit starts");
+    fit.run().expect("the fit runs");
+    FitReport::of(fit.as_ref())
+}
+
+#[test]
+fn the_surface_to_data_distance_is_measured_when_a_surface_fit_stops() {
+    let wave = |x: f64, y: f64| 3.0 * (x / 8.0).sin() * (y / 6.0).cos();
+    let mesh = common::meshes::tri_grid(40, wave);
+    let points = geofit::mesh::PolyMesh::try_new(mesh.positions().to_vec(), Vec::<[u32; 3]>::new())
+        .expect("points");
+    // A height field, from its faces and from its bare points (the reference is then the
+    // points' reconstruction): the surface stays on the data.
+    for (what, data) in [("mesh", &mesh), ("points", &points)] {
+        for method in [Method::Geometric, Method::LeastSquares] {
+            let r = surface_report(data, method);
+            assert_eq!(r.status, FitStatus::Converged, "{what} {method:?}");
+            let back = r.e_back_max_pct.expect("E_back measured");
+            let last = r.history.last().and_then(|h| h.e_back_max_pct);
+            println!(
+                "{what} {method:?}: E_max {:.4} %, E_back {back:.4} %",
+                r.e_max_pct
+            );
+            assert_eq!(last, Some(back), "the last iteration carries it");
+            assert!(back <= 2.0 * 0.1, "{what} {method:?}: E_back {back} %");
+        }
+    }
+    // A closed sphere as one sheet: the sheet holds every point it is fitted to, but folds
+    // over itself at the silhouette, far from the data, and E_back says so.
+    let ico = common::meshes::refine_flat(&common::meshes::icosahedron(), 3);
+    let sphere = geofit::mesh::PolyMesh::try_new(
+        ico.positions().iter().map(|p| p.normalize()).collect(),
+        ico.triangles(),
+    )
+    .expect("sphere");
+    let r = surface_report(&sphere, Method::Geometric);
+    let back = r.e_back_max_pct.expect("E_back measured");
+    println!("sphere: E_max {:.4} %, E_back {back:.4} %", r.e_max_pct);
+    assert!(back > 5.0 * r.e_max_pct.max(0.1), "sphere: E_back {back} %");
 }

@@ -32,8 +32,9 @@ use super::surface::{
     GeometricSurfaceOptions, LsqSurfaceFitter, LsqSurfaceOptions, SectionsFitter, SectionsOptions,
     SurfaceGrid, TolMode,
 };
+use super::DataSurface;
 use super::{Acceleration, FitError, Fitter, Tolerances};
-use crate::cloud::{ReconstructOptions, SurfaceKind};
+use crate::cloud::{reconstruct, ReconstructOptions, SurfaceKind};
 use crate::geom::{Point3, Vec3};
 use crate::io::{LoadedFile, RangeGrid};
 use crate::mesh::{FeatureLine, FeatureOptions, PolyMesh};
@@ -817,6 +818,10 @@ impl FitSpec {
                 }
             }
         };
+        if self.scheme == Scheme::BsplineSurface {
+            let reference = self.back_reference(data);
+            fitter.state_mut().set_reference(reference);
+        }
         let own = fitter.log().precompute_seconds();
         let outside = start.elapsed().as_secs_f64() - own;
         fitter.log_mut().add_precompute(outside);
@@ -904,6 +909,19 @@ impl FitSpec {
                 .unwrap_or(FeatureOptions::DEFAULT_ANGLE_DEG),
             ..FeatureOptions::default()
         })
+    }
+
+    /// The data's surface a B-spline surface fit's E_back is measured against: the data's
+    /// faces, else the mesh of the points that a subdivision fit starts from (the range grid's
+    /// triangles for a range scan, so the same E_back for both). `None` when no mesh can be
+    /// made of the points: the fit then reports no E_back, and fits on.
+    fn back_reference(&self, data: &FitData) -> Option<DataSurface> {
+        if !data.mesh.is_point_cloud() {
+            return DataSurface::of_mesh(data.mesh);
+        }
+        let grid = data.grid.filter(|_| self.use_grid);
+        let mesh = reconstruct(data.mesh.positions(), grid, &self.cloud_options()).ok()?;
+        DataSurface::of_mesh(&mesh.mesh)
     }
 
     fn cloud_options(&self) -> ReconstructOptions {

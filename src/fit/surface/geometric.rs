@@ -254,6 +254,7 @@ impl Fitter for GeometricSurfaceFitter {
                 FitStatus::MaxIterations
             }
         };
+        self.fit.measure_back(status);
         let n = self.fit.surface.control_points().len();
         Ok(self.fit.state.record(start, n, refined, status))
     }

@@ -438,6 +438,7 @@ impl Fitter for LsqSurfaceFitter {
                 FitStatus::MaxIterations
             }
         };
+        self.fit.measure_back(status);
         let n = self.fit.surface.control_points().len();
         Ok(self.fit.state.record(start, n, refined, status))
     }

@@ -551,6 +551,9 @@ impl Fitter for SectionsFitter {
         if status != FitStatus::Running {
             self.stage = Stage::Done;
         }
+        if status != FitStatus::Running {
+            super::measure_back(&mut self.state, &self.surface, &self.uv);
+        }
         let n = self.surface.control_points().len();
         Ok(self.state.record(start, n, true, status))
     }
