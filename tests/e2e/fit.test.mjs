@@ -333,6 +333,9 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     console.log(`[e2e] ${backend.name} bspline-surface: ${JSON.stringify(stats)}`);
     assert.equal(stats.scheme, 'bspline-surface');
     assert.equal(stats.status, 'converged');
+    // Measured when the fit stops, against the sample's reconstruction (docs/splines.md).
+    assert.ok(Number.isFinite(stats.eBackMaxPct) && stats.eBackMaxPct < 5, JSON.stringify(stats));
+    assert.match(await page.textContent('#fit-eback'), /%/);
     await page.check('#show-iso');
     await page.waitForTimeout(300);
     const iso = await viewPixels(page, `fit-bspline-iso-${backend.name}.png`);
