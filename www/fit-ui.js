@@ -16,7 +16,7 @@ import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
 import {
   CAGE_COLOR, CHART_CONTEXT, CREASE_COLOR, DATA_CREASE_COLOR, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
-  drawHistogram, edgeSegments, errorColors, fmtPct, fmtUnits, lineSet,
+  distanceColors, drawHistogram, edgeSegments, errorColors, fmtPct, fmtUnits, lineSet,
 } from './fit-view.js';
 
 export { drawChart, errorColors } from './fit-view.js';
@@ -94,6 +94,7 @@ class FitPanel {
       refine: /** @type {HTMLInputElement} */ (el('fit-refine')), maxControl: /** @type {HTMLInputElement} */ (el('fit-max-control')),
       play: el('fit-play'), step: el('fit-step'), reset: el('fit-reset'),
       vectors: /** @type {HTMLInputElement} */ (el('show-vectors')), cage: /** @type {HTMLInputElement} */ (el('show-cage')),
+      backColors: /** @type {HTMLInputElement} */ (el('show-back')), backLegend: el('back-legend'), backLegendTol: el('back-legend-tol'),
       iso: /** @type {HTMLInputElement} */ (el('show-iso')), untrimmed: /** @type {HTMLInputElement} */ (el('show-untrimmed')), initialMesh: /** @type {HTMLInputElement} */ (el('show-initial')),
       chart: /** @type {HTMLCanvasElement} */ (el('fit-chart')),
       status: el('fit-status'), iter: el('fit-iter'), ctrl: el('fit-ctrl'), eAvg: el('fit-eavg'),
@@ -121,6 +122,9 @@ class FitPanel {
     this.pending = null;
     this.once = null;
     this.showing = false;
+    // The newest distances of the surface's vertices to the data (see protocol.js), while the
+    // surface is coloured by them.
+    this.distances = null;
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
     // deviation: the latest frame's distribution of the errors (the package's `Deviation`).
@@ -130,6 +134,8 @@ class FitPanel {
       linkTolerance(this.ui.tolMax, this.ui.tolMaxUnits, () => this.diagonal(), () => this.form.edited.add('tolMax')),
     ];
     this.bind();
+    // A browser may restore the checkbox checked: the worker must hear of it.
+    if (this.ui.backColors.checked) this.backColorsChanged();
     this.go('idle');
   }
 
@@ -149,7 +155,7 @@ class FitPanel {
   /** Asks the worker for a new fit of the current scan with the form's options (iteration 0). */
   restart() {
     if (!this.scan) return;
-    Object.assign(this, { playing: false, frame: null, pending: null, once: null });
+    Object.assign(this, { playing: false, frame: null, pending: null, once: null, distances: null });
     this.generation += 1;
     this.built = this.generation;
     this.go('building');
@@ -160,9 +166,9 @@ class FitPanel {
   /** Forgets the fit (a new scan was loaded): the page shows the scan until Play, Step or Reset. */
   clear() {
     this.generation += 1;
-    Object.assign(this, { built: 0, playing: false, frame: null, pending: null, once: null });
+    Object.assign(this, { built: 0, playing: false, frame: null, pending: null, once: null, distances: null });
     this.worker.postMessage({ type: MSG.clear, generation: this.generation });
-    Object.assign(this.figures, { lastStats: null, history: [], deviation: null });
+    Object.assign(this.figures, { lastStats: null, history: [], deviation: null, distanceColored: 0, distanceFar: 0 });
     const u = this.ui;
     for (const dd of [u.iter, u.ctrl, u.eAvg, u.eMax, u.eRms, u.eBack, u.ms, u.total, u.devMean, u.devP50, u.devP95, u.devMax, u.devWithin]) {
       dd.textContent = '—';
@@ -201,6 +207,11 @@ class FitPanel {
     return ((stats.tolMaxPct ?? 0) * stats.diagonal) / 100;
   }
 
+  /** The surface → data distance (units) beyond which a surface strays from the data. */
+  tolBackUnits(stats) {
+    return ((stats.tolBackPct ?? 0) * stats.diagonal) / 100;
+  }
+
   /** The line layer: fitted curve, control net, error vectors, iso lines, initial net. */
   lines() {
     const parts = [];
@@ -223,13 +234,46 @@ class FitPanel {
     viewer.setPoints(this.once.data, errorColors(this.frame.errors, this.tolMaxUnits(this.frame.stats)));
   }
 
+  /**
+   * The surface's vertex colours by distance to the data while that view is on and the newest
+   * distances belong to a tessellation of the same size (a running fit measures them only
+   * now and then: its surface moves little in between); else none (the clay colour). Counts
+   * the vertices of the drawn `indices` that stray (`figures.distanceFar`).
+   * @param {Uint32Array} indices
+   */
+  surfaceColors(indices) {
+    const n = this.frame.limit.positions.length / 3;
+    const d = this.distances;
+    const on = this.ui.backColors.checked && d !== null && d.length === n && n > 0;
+    const far = this.tolBackUnits(this.frame.stats);
+    this.figures.distanceColored = on ? n : 0;
+    this.figures.distanceFar = 0;
+    if (!on) return undefined;
+    const counted = new Uint8Array(n);
+    for (const i of indices) {
+      if (counted[i] || !(d[i] > far)) continue;
+      counted[i] = 1;
+      this.figures.distanceFar += 1;
+    }
+    return distanceColors(d, far);
+  }
+
   drawSurface(viewer) {
     const { limit, untrimmed } = this.frame;
     const whole = untrimmed && this.ui.untrimmed.checked;
     this.figures.surfaceTriangles = (whole ? untrimmed.indices.length : limit.indices.length) / 3;
-    if (whole) viewer.setMesh(limit.positions, untrimmed.normals, untrimmed.indices);
-    else if (limit.indices.length > 0) viewer.setMesh(limit.positions, limit.normals, limit.indices);
+    const colors = this.surfaceColors(whole ? untrimmed.indices : limit.indices);
+    if (whole) viewer.setMesh(limit.positions, untrimmed.normals, untrimmed.indices, colors);
+    else if (limit.indices.length > 0) viewer.setMesh(limit.positions, limit.normals, limit.indices, colors);
     else viewer.setMesh(new Float32Array(), new Float32Array(), new Uint32Array());
+  }
+
+  /** The surface-by-distance view was switched: the worker measures distances while it is on. */
+  backColorsChanged() {
+    const on = this.ui.backColors.checked;
+    this.ui.backLegend.hidden = !on;
+    this.worker.postMessage({ type: MSG.view, distances: on });
+    this.redraw();
   }
 
   drawLines(viewer) {
@@ -263,6 +307,7 @@ class FitPanel {
     const tol = this.tolMaxUnits(s);
     u.legendTol.textContent = `+${fmtUnits(tol)}`;
     u.legendNeg.textContent = `−${fmtUnits(tol)}`;
+    u.backLegendTol.textContent = fmtUnits(this.tolBackUnits(s));
     document.body.dataset.fitIter = String(s.iter);
   }
 
@@ -338,6 +383,7 @@ class FitPanel {
         this.showIntake(m.once.notes);
       }
       this.frame = m;
+      if (m.distances) this.distances = m.distances;
       Object.assign(this.figures, { lastStats: m.stats, history: m.history, creaseEdges: m.control.creases.length / 2, creaseCurveSegments: m.creaseCurves.length / 6, dataCreaseSegments: this.once.dataCreases.length / 6 });
       this.figures.frames += 1;
       this.showStats(m.stats);
@@ -388,6 +434,7 @@ class FitPanel {
       if (m.generation !== this.generation) return;
       // What a fit's first frame carries once: keep it if a newer frame overtakes that one.
       if (this.pending?.once && !m.once) m.once = this.pending.once;
+      if (this.pending?.distances && !m.distances) m.distances = this.pending.distances;
       this.pending = m;
       if (!this.showing) {
         this.showing = true;
@@ -423,6 +470,7 @@ class FitPanel {
     }
     u.refine.addEventListener('change', () => { u.maxControl.disabled = !u.refine.checked; });
     for (const box of [u.cage, u.vectors, u.iso, u.untrimmed, u.initialMesh]) box.addEventListener('change', () => this.redraw());
+    u.backColors.addEventListener('change', () => this.backColorsChanged());
     for (const button of document.querySelectorAll('[data-export]')) {
       const what = /** @type {HTMLElement} */ (button).dataset.export;
       button.addEventListener('click', () => this.worker.postMessage({ type: MSG.export, what }));

@@ -8,6 +8,8 @@ const INSIDE_ZERO = [0.92, 0.92, 0.9];
 const INSIDE_POS = [1.0, 0.74, 0.62];
 const OUTSIDE_NEG = [0.05, 0.25, 0.95];
 const OUTSIDE_POS = [0.9, 0.08, 0.05];
+// A surface vertex over a hole of the data or beyond its outline: no distance is measured there.
+const UNMEASURED = [0.45, 0.49, 0.56];
 export const VECTOR_COLOR = [1.0, 0.85, 0.2];
 export const CAGE_COLOR = [0.35, 0.95, 0.55];
 export const CREASE_COLOR = [1.0, 0.3, 0.35];
@@ -35,6 +37,23 @@ export function errorColors(errors, tol) {
     else if (t >= 0) c = mix(INSIDE_ZERO, INSIDE_POS, t);
     else c = mix(INSIDE_ZERO, INSIDE_NEG, -t);
     colors.set(c, i * 3);
+  }
+  return colors;
+}
+
+/**
+ * One sRGB colour per surface vertex from its distance to the data `d` (model units; negative:
+ * not measured, over a hole) and the distance `far` (units) beyond which the surface strays:
+ * pale to warm within it, saturated red beyond, grey where unmeasured.
+ * @param {Float32Array} distances
+ * @param {number} far
+ */
+export function distanceColors(distances, far) {
+  const colors = new Float32Array(distances.length * 3);
+  for (let i = 0; i < distances.length; i += 1) {
+    const d = distances[i];
+    const t = far > 0 ? d / far : 0;
+    colors.set(d < 0 ? UNMEASURED : t > 1 ? OUTSIDE_POS : mix(INSIDE_ZERO, INSIDE_POS, t), i * 3);
   }
   return colors;
 }

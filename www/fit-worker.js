@@ -4,7 +4,9 @@
 // posts a frame (see protocol.js): statistics, history, signed point errors and their
 // distribution (figures and histogram), the limit mesh (or
 // curve), the control-net edges, the error vectors and iso-parameter lines, all as transferable
-// typed arrays.
+// typed arrays. While the page colours the surface by its distance to the data, frames also carry
+// those distances, measured on every frame of a fit that stands still and, while it runs, only as
+// often as keeps them under a tenth of the worker's time.
 import init, { Fitter, loadFile } from '../pkg/geofit.js';
 import { MSG, frameTransfers } from './protocol.js';
 
@@ -18,6 +20,11 @@ const MAX_TRIANGLES = 40_000;
 // Bins of the deviation histogram the page draws.
 const HISTOGRAM_BINS = 64;
 let resolution = LIMIT_RESOLUTION;
+// While running, the surface's distances are measured again only when DISTANCE_DUTY times their
+// last cost has passed since (bun000's B-spline surface: ~85K vertices, a quarter second).
+const DISTANCE_DUTY = 10;
+/** Whether the page wants the surface's distances to the data, and when and at what cost (ms) they were last measured. */
+const distances = { wanted: false, at: -Infinity, ms: 0 };
 
 /** @type {Fitter | null} */
 let fitter = null;
@@ -54,6 +61,13 @@ function postFrame(f, kind) {
     whole.free();
   }
   const control = f.controlMesh();
+  const now = performance.now();
+  let surfaceDistances = null;
+  if (distances.wanted && (!running || now - distances.at >= DISTANCE_DUTY * distances.ms)) {
+    surfaceDistances = f.surfaceDistances(limit.positions);
+    distances.at = performance.now();
+    distances.ms = distances.at - now;
+  }
   /** @type {import('./protocol.js').FrameMessage} */
   const frame = {
     type: MSG.frame,
@@ -70,6 +84,7 @@ function postFrame(f, kind) {
     vectors: f.errorVectors(),
     iso: f.isoLines(resolution),
     creaseCurves: f.creaseCurves(resolution),
+    distances: surfaceDistances,
   };
   limit.free();
   control.free();
@@ -123,6 +138,11 @@ const handlers = {
     if (!fitter || playing) return;
     playing = true;
     play(generation);
+  },
+  [MSG.view]({ distances: wanted }) {
+    distances.wanted = wanted;
+    distances.at = -Infinity;
+    if (fitter && !playing && wanted) postFrame(fitter, 'pause');
   },
   [MSG.pause]() {
     playing = false;

@@ -16,7 +16,9 @@
  *   Export the fit (`what` from `exportsFor(scheme)`).
  * @typedef {{ type: 'clear', generation: number }} ClearMessage
  *   Forget the fit (a new file was loaded).
- * @typedef {StartMessage | DriveMessage | ExportMessage | ClearMessage} ToWorker
+ * @typedef {{ type: 'view', distances: boolean }} ViewMessage
+ *   Whether frames carry the surface's distances to the data (to colour the surface by them).
+ * @typedef {StartMessage | DriveMessage | ExportMessage | ClearMessage | ViewMessage} ToWorker
  */
 
 /**
@@ -28,12 +30,14 @@
  *   deviation: import('../pkg/geofit.js').Deviation,
  *   limit: Shape, untrimmed: { normals: Float32Array, indices: Uint32Array } | null,
  *   control: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array },
- *   vectors: Float32Array, iso: Float32Array, creaseCurves: Float32Array,
+ *   vectors: Float32Array, iso: Float32Array, creaseCurves: Float32Array, distances: Float32Array | null,
  *   once?: { data: Float32Array, initial: { positions: Float32Array, edges: Uint32Array, creases: Uint32Array }, dataCreases: Float32Array, notes: string[] },
  * }} FrameMessage
  *   The state of the fit after a slice (`limit` a B-spline surface cut to the data's outline,
  *   `untrimmed` its whole tessellation over the same positions); `once` (data points, initial control net and what was
- *   done to the data on intake) only on the first frame of a fit.
+ *   done to the data on intake) only on the first frame of a fit; `distances` (per vertex of `limit`,
+ *   model units, −1 over a hole of the data; empty when the fit measures none) only while the page
+ *   asked for them with a `view` message, and not on every frame of a running fit.
  * @typedef {{ type: 'exported', what: string, bytes: Uint8Array, quality?: import('../pkg/geofit.js').FemQuality }} ExportedMessage
  *   An export's bytes; `quality` for the FEM mesh (`msh`).
  * @typedef {{ type: 'error', during: string, generation: number, message: string }} ErrorMessage
@@ -48,6 +52,7 @@ export const MSG = Object.freeze({
   step: 'step',
   export: 'export',
   clear: 'clear',
+  view: 'view',
   frame: 'frame',
   exported: 'exported',
   error: 'error',
@@ -63,6 +68,7 @@ export function frameTransfers(frame) {
     frame.errors, frame.limit.positions, frame.limit.normals, frame.limit.indices, frame.limit.edges,
     frame.control.positions, frame.control.edges, frame.vectors, frame.iso,
   ];
+  if (frame.distances) arrays.push(frame.distances);
   if (frame.untrimmed) arrays.push(frame.untrimmed.normals, frame.untrimmed.indices);
   if (frame.once) arrays.push(frame.once.data, frame.once.initial.positions, frame.once.initial.edges);
   return arrays.map((a) => /** @type {ArrayBuffer} */ (a.buffer));

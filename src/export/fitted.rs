@@ -89,10 +89,17 @@ pub fn step_of(fit: &dyn Fitter, name: &str) -> Result<String, ExportError> {
     write_step(&cad_model(fit)?, name)
 }
 
-/// The fitted surface tessellated for OBJ/PLY/STL ([`EXPORT_RESOLUTION`] segments per patch
-/// edge); a curve has none.
+/// The fitted surface tessellated for OBJ/PLY/STL/GLB ([`EXPORT_RESOLUTION`] segments per
+/// patch edge), a B-spline surface cut to its trim as the page draws it and STEP and IGES
+/// write it (the rectangle beyond the data curls away from it); a curve has none.
 pub fn surface_mesh(fit: &dyn Fitter) -> Result<PolyMesh, ExportError> {
-    match fit.limit_shape(EXPORT_RESOLUTION) {
+    let trimmed = fit
+        .trimmed_limit_shape(EXPORT_RESOLUTION)
+        .map(|shape| match shape {
+            Shape::Mesh(mesh) => Shape::Mesh(mesh.without_unused_vertices().0),
+            curve => curve,
+        });
+    match trimmed.unwrap_or_else(|| fit.limit_shape(EXPORT_RESOLUTION)) {
         Shape::Mesh(mesh) => Ok(mesh),
         Shape::Polyline { .. } => Err(ExportError::Unsupported {
             what: format!(

@@ -194,6 +194,11 @@ pub trait Fitter {
         self.state().back()
     }
 
+    /// The surface → data distance of each of `points` ([`FitState::distances_to_data`]).
+    fn distances_to_data(&self, points: &[Point3]) -> Option<Vec<Option<f64>>> {
+        self.state().distances_to_data(points)
+    }
+
     /// The point of the surface or curve each data point is measured to, in data order.
     fn foot_points(&self) -> Vec<Point3>;
 

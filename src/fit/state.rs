@@ -74,6 +74,14 @@ impl FitState {
         distances
     }
 
+    /// The distance to the data of every one of `points` (points of the fitted surface, such
+    /// as its display tessellation), model units, `None` over a hole of the data or beyond its
+    /// outline; `None` as a whole when this fit measures no surface → data distance. Leaves
+    /// the fit's own statistics alone: this is for views (a surface coloured by its distance).
+    pub fn distances_to_data(&self, points: &[Point3]) -> Option<Vec<Option<f64>>> {
+        self.reference.as_ref().map(|r| r.distances(points))
+    }
+
     /// The last surface → data statistics, when they are measured.
     pub fn back(&self) -> Option<BackStats> {
         self.back

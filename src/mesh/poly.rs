@@ -100,6 +100,19 @@ impl PolyMesh {
         (mesh, new_index)
     }
 
+    /// The mesh without the vertices no face uses (a trimmed tessellation keeps its whole
+    /// grid of points), and the new index of every old vertex as [`PolyMesh::without_vertices`].
+    pub fn without_unused_vertices(&self) -> (PolyMesh, Vec<u32>) {
+        let mut used = vec![false; self.num_vertices()];
+        for &v in &self.face_indices {
+            used[v as usize] = true;
+        }
+        let drop: Vec<u32> = (0..self.num_vertices() as u32)
+            .filter(|&v| !used[v as usize])
+            .collect();
+        self.without_vertices(&drop)
+    }
+
     fn push_face(&mut self, face: usize, f: &[u32]) -> Result<(), MeshError> {
         if f.len() < 3 {
             return Err(MeshError::FaceTooSmall { face, len: f.len() });
@@ -224,5 +237,14 @@ mod tests {
         assert_eq!(new_index, vec![0, crate::mesh::NONE, 1, 2, 3]);
         assert_eq!(kept.positions(), &[p(0.0), p(2.0), p(3.0), p(4.0)]);
         assert_eq!(kept.faces().collect::<Vec<_>>(), vec![&[1u32, 2, 3, 0][..]]);
+    }
+
+    #[test]
+    fn unused_vertices_are_dropped_and_the_faces_renumbered() {
+        let m = PolyMesh::try_new(vec![p(0.0), p(1.0), p(2.0), p(3.0)], [vec![1, 3, 2]]).unwrap();
+        let (kept, new_index) = m.without_unused_vertices();
+        assert_eq!(new_index, vec![crate::mesh::NONE, 0, 1, 2]);
+        assert_eq!(kept.positions(), &[p(1.0), p(2.0), p(3.0)]);
+        assert_eq!(kept.faces().collect::<Vec<_>>(), vec![&[0u32, 2, 1][..]]);
     }
 }

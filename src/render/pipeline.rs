@@ -16,11 +16,9 @@ pub struct Uniforms {
     pub eye: [f32; 4],
     /// Viewport width and height in pixels, point diameter in pixels, 1 to encode sRGB by hand.
     pub viewport: [f32; 4],
-    /// Mesh colour, sRGB (a unused).
-    pub mesh_color: [f32; 4],
     /// Wireframe colour, sRGB (a unused).
     pub wire_color: [f32; 4],
-    /// x: 1 to shade the mesh with zebra stripes (reflection lines) instead of the clay
+    /// x: 1 to shade the mesh with zebra stripes (reflection lines) instead of its colours
     /// (y, z, w unused).
     pub shading: [f32; 4],
 }
@@ -48,6 +46,7 @@ pub struct Pipelines {
 
 const XYZ: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
 const RGB: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![1 => Float32x3];
+const MESH_RGB: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![2 => Float32x3];
 
 /// A tightly packed buffer of vec3<f32>, one per vertex or per instance.
 fn vec3_buffer(
@@ -115,6 +114,7 @@ impl Pipelines {
                 buffers: &[
                     Some(vec3_buffer(&XYZ, per_vertex)),
                     Some(vec3_buffer(&RGB, per_vertex)),
+                    Some(vec3_buffer(&MESH_RGB, per_vertex)),
                 ],
                 topology: wgpu::PrimitiveTopology::TriangleList,
             }),

@@ -7,8 +7,8 @@ use glam::Vec3;
 
 /// Background colour, sRGB (a dark slate), as the page shows it on every backend.
 const BACKGROUND: [f64; 3] = [0.11, 0.13, 0.17];
-/// Mesh colour, sRGB: a light clay.
-const MESH_COLOR: [f32; 4] = [0.80, 0.76, 0.70, 1.0];
+/// Mesh colour, sRGB: a light clay, for a mesh given without colours.
+const MESH_COLOR: [f32; 3] = [0.80, 0.76, 0.70];
 /// Wireframe colour, sRGB: dark grey.
 const WIRE_COLOR: [f32; 4] = [0.10, 0.10, 0.12, 1.0];
 /// Point diameter in CSS pixels unless the page sets another.
@@ -116,6 +116,8 @@ pub struct Renderer {
     depth: wgpu::TextureView,
     points: Vec3Pair,
     mesh: Vec3Pair,
+    /// The mesh's colours (sRGB per vertex; [`MESH_COLOR`] when the page gives none).
+    mesh_colors: DynBuffer,
     triangles: Indices,
     edges: Indices,
     /// The triangle indices whose wireframe edges are not built yet: edges are made only when
@@ -160,6 +162,7 @@ impl Renderer {
             depth: depth_view(&gpu),
             points: Vec3Pair::new(device),
             mesh: Vec3Pair::new(device),
+            mesh_colors: DynBuffer::new(device, wgpu::BufferUsages::VERTEX),
             triangles: index_buffer(),
             edges: index_buffer(),
             stale_edges: None,
@@ -198,18 +201,34 @@ impl Renderer {
     }
 
     /// Replaces the triangle mesh: three values per vertex in `positions` and `normals`, three
-    /// vertex indices per triangle in `indices`.
+    /// vertex indices per triangle in `indices`, and `colors` (sRGB, 0..1, three per vertex),
+    /// or none for the clay colour.
     pub fn set_mesh(
         &mut self,
         positions: &[f32],
         normals: &[f32],
         indices: &[u32],
+        colors: Option<&[f32]>,
     ) -> Result<(), RenderError> {
         check_xyz("mesh positions", positions)?;
         check_same_len("mesh normals", normals, positions.len())?;
         check_finite("mesh normals", normals)?;
         check_indices("triangle indices", indices, 3, positions.len() / 3)?;
+        let clay: Vec<f32>;
+        let colors = match colors {
+            Some(c) => {
+                check_same_len("mesh colors", c, positions.len())?;
+                check_finite("mesh colors", c)?;
+                c
+            }
+            None => {
+                clay = MESH_COLOR.repeat(positions.len() / 3);
+                &clay
+            }
+        };
         self.mesh.write(&self.gpu, positions, normals);
+        self.mesh_colors
+            .write(&self.gpu, bytemuck::cast_slice(colors));
         self.triangles.write(&self.gpu, indices);
         self.stale_edges = Some(indices.to_vec());
         self.bounds[1] = xyz_bounds(positions);
@@ -244,7 +263,7 @@ impl Renderer {
         };
     }
 
-    /// Shades the mesh with zebra stripes (reflection lines) instead of the clay colour.
+    /// Shades the mesh with zebra stripes (reflection lines) instead of its colours.
     pub fn set_zebra(&mut self, on: bool) {
         self.zebra = on;
     }
@@ -348,6 +367,7 @@ impl Renderer {
         if self.layers.mesh && self.triangles.count > 0 {
             pass.set_pipeline(&self.pipelines.mesh);
             self.mesh.bind(pass);
+            pass.set_vertex_buffer(2, self.mesh_colors.slice(u64::from(self.mesh.count) * 12));
             pass.set_index_buffer(
                 self.triangles
                     .buffer
@@ -404,7 +424,6 @@ impl Renderer {
                     0.0
                 },
             ],
-            mesh_color: MESH_COLOR,
             wire_color: WIRE_COLOR,
             shading: [if self.zebra { 1.0 } else { 0.0 }, 0.0, 0.0, 0.0],
         };

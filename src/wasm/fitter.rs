@@ -8,7 +8,7 @@ use crate::export;
 use crate::fem;
 use crate::fit::{
     DeviationHistogram, DeviationStats, FitReport, FitSpec, FitStatus, Fitter as CoreFitter,
-    IterationRecord, Method, Scheme, Shape,
+    IterationRecord, Method, Scheme, Shape, BACK_TOLERANCE_FACTOR,
 };
 use crate::geom::Point3;
 use crate::io;
@@ -115,6 +115,9 @@ struct JsStats {
     /// data, % of the diagonal (`null` where not measured).
     e_back_max_pct: Option<f64>,
     e_back_p99_pct: Option<f64>,
+    /// The E_back a converged fit stays within: [`BACK_TOLERANCE_FACTOR`] E_max tolerances,
+    /// % (`null` without an E_max tolerance).
+    tol_back_pct: Option<f64>,
 }
 
 /// One history entry (camelCase plain object).
@@ -371,6 +374,7 @@ impl Fitter {
             tol_rms_pct: f.tolerances().rms_pct,
             e_back_max_pct: f.back_stats().map(|b| b.max_pct),
             e_back_p99_pct: f.back_stats().map(|b| b.p99_pct),
+            tol_back_pct: f.tolerances().max_pct.map(|t| BACK_TOLERANCE_FACTOR * t),
         };
         to_js(&stats)
     }
@@ -467,6 +471,25 @@ impl Fitter {
     pub fn data_creases(&self) -> Vec<f32> {
         let log = self.fit.state().log();
         buffers::to_f32_xyz(log.creases().map_or(&[][..], |c| &c.segments))
+    }
+
+    /// The distance to the data of every point `x, y, z` in `positions` (the `positions` of
+    /// [`Fitter::limit_mesh`], to colour the surface by how far it strays), model units; −1
+    /// for a point over a hole of the data or beyond its outline (the points E_back leaves
+    /// out). Empty when the fit measures no surface → data distance (curves).
+    #[wasm_bindgen(js_name = surfaceDistances)]
+    pub fn surface_distances(&self, positions: &[f32]) -> Vec<f32> {
+        let points: Vec<Point3> = positions
+            .chunks_exact(3)
+            .map(|p| Point3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+            .collect();
+        self.fit
+            .distances_to_data(&points)
+            .map_or_else(Vec::new, |d| {
+                d.into_iter()
+                    .map(|d| d.map_or(-1.0, |d| d as f32))
+                    .collect()
+            })
     }
 
     /// Error vectors as line segments: data point, then its foot point, `x, y, z` each.

@@ -90,6 +90,8 @@ export interface FitStats {
   /** Surface → data: largest and 99th-percentile distance, % (`null` where not measured). */
   eBackMaxPct: number | null;
   eBackP99Pct: number | null;
+  /** The E_back a converged fit stays within (twice the E_max tolerance), % (`null` without an E_max tolerance). */
+  tolBackPct: number | null;
 }
 
 /** One entry of `Fitter.history()`. */

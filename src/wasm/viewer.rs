@@ -34,15 +34,19 @@ impl Viewer {
         Ok(self.renderer.set_points(positions, colors)?)
     }
 
-    /// Replaces the mesh: `x, y, z` positions and normals per vertex, three indices per triangle.
+    /// Replaces the mesh: `x, y, z` positions and normals per vertex, three indices per
+    /// triangle, and optionally `r, g, b` (sRGB, 0..1) per vertex (left out: a clay colour).
     #[wasm_bindgen(js_name = setMesh)]
     pub fn set_mesh(
         &mut self,
         positions: &[f32],
         normals: &[f32],
         indices: &[u32],
+        colors: Option<Vec<f32>>,
     ) -> Result<(), JsError> {
-        Ok(self.renderer.set_mesh(positions, normals, indices)?)
+        Ok(self
+            .renderer
+            .set_mesh(positions, normals, indices, colors.as_deref())?)
     }
 
     /// Replaces the line set: two `x, y, z` vertices per segment, `r, g, b` (sRGB) per vertex.

@@ -55,6 +55,48 @@ function viewPixels(page, file) {
   });
 }
 
+/**
+ * Colours the fitted surface by its distance to the data (points hidden), trimmed and untrimmed,
+ * and checks the picture against the page's figures: every vertex coloured, the clay gone, red
+ * where vertices stray beyond twice the E_max tolerance, and more grey (unmeasured) beyond the
+ * data's outline once the surface is drawn untrimmed. Switches the view off again, and checks
+ * the clay is back.
+ */
+async function distanceView(page, stats, backendName) {
+  const classes = {
+    red: (r, g, b) => r > 150 && g < 60 && b < 60,
+    grey: (r, g, b) => b - r > 10 && b - r < 45 && r > 55 && r < 140 && Math.abs(g - (r + b) / 2) < 12,
+    clay: (r, g, b) => r > 120 && r - b > 15 && r - b < 60 && Math.abs(r - g) < 25 && g - b > 8,
+  };
+  const figures = () => page.evaluate(() => ({ colored: window.geofitFit.distanceColored, far: window.geofitFit.distanceFar }));
+  const clay = await countPixels(page, '#view', `fit-distance-off-${backendName}.png`, classes);
+  await page.check('#show-back');
+  await page.waitForFunction(() => window.geofitFit.distanceColored > 0, null, { timeout: TIMEOUT_MS });
+  await page.waitForTimeout(300);
+  const trimmed = await countPixels(page, '#view', `fit-distance-${backendName}.png`, classes);
+  const { colored, far } = await figures();
+  await page.check('#show-untrimmed');
+  await page.waitForTimeout(300);
+  const whole = await countPixels(page, '#view', `fit-distance-untrimmed-${backendName}.png`, classes);
+  const wholeFar = (await figures()).far;
+  await page.uncheck('#show-untrimmed');
+  await page.uncheck('#show-back');
+  await page.waitForTimeout(300);
+  const after = await countPixels(page, '#view', `fit-distance-after-${backendName}.png`, classes);
+  const seen = JSON.stringify({ clay, trimmed, whole, after, colored, far, wholeFar, eBack: stats.eBackMaxPct, tolBack: stats.tolBackPct });
+  console.log(`[e2e] ${backendName} distance view: ${seen}`);
+  assert.equal(await page.isHidden('#back-legend'), true, 'the legend goes with the view');
+  assert.ok(clay.clay > 2000 && trimmed.clay < 0.05 * clay.clay && after.clay > 0.9 * clay.clay, `clay replaced and restored: ${seen}`);
+  // Red only where drawn vertices stray (points and lines are off); the face's sheet beyond the
+  // outline strays (E_back leaves it out: no data point's foot lies there).
+  for (const [n, px] of [[far, trimmed], [wholeFar, whole]]) {
+    assert.ok(n > 0 ? px.red > 0 : px.red < 50, `red where vertices stray: ${seen}`);
+  }
+  assert.ok(wholeFar > far, `the untrimmed surface strays beyond the outline: ${seen}`);
+  assert.ok(whole.grey > trimmed.grey + 1000, `the surface beyond the data's outline is unmeasured: ${seen}`);
+  return { colored, far };
+}
+
 /** Clicks an export button and returns the downloaded bytes and file name. */
 async function exportBytes(page, what, tag) {
   const [download] = await Promise.all([page.waitForEvent('download'), page.click(`[data-export="${what}"]`)]);
@@ -350,6 +392,7 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     await page.waitForTimeout(300);
     const zebra = await viewPixels(page, `fit-bspline-zebra-${backend.name}.png`);
     await page.uncheck('#show-zebra');
+    const distance = await distanceView(page, stats, backend.name);
     await page.check('#show-points');
     // Drawn cut to the data's outline; the toggle shows the whole rectangle of the surface.
     const trimmed = await page.evaluate(() => window.geofitFit.surfaceTriangles);

@@ -8,8 +8,6 @@ struct Uniforms {
     eye: vec4<f32>,
     // xy: viewport size in pixels; z: point diameter in pixels; w: 1 to encode sRGB by hand.
     viewport: vec4<f32>,
-    // rgb: the mesh colour (sRGB).
-    mesh_color: vec4<f32>,
     // rgb: the wireframe colour (sRGB).
     wire_color: vec4<f32>,
     // x: 1 for zebra stripes on the mesh.
@@ -82,14 +80,20 @@ struct MeshOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    @location(2) color: vec3<f32>,
 };
 
 @vertex
-fn vs_mesh(@location(0) position: vec3<f32>, @location(1) normal: vec3<f32>) -> MeshOut {
+fn vs_mesh(
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec3<f32>,
+) -> MeshOut {
     var out: MeshOut;
     out.clip = u.view_proj * vec4(position, 1.0);
     out.world = position;
     out.normal = normal;
+    out.color = srgb_to_linear(color);
     return out;
 }
 
@@ -116,8 +120,7 @@ fn fs_mesh(in: MeshOut) -> @location(0) vec4<f32> {
     if u.shading.x > 0.5 {
         return output(zebra(n, l, d));
     }
-    let base = srgb_to_linear(u.mesh_color.rgb);
-    let lit = base * (0.15 + 0.85 * d) + vec3(0.25 * pow(d, 40.0));
+    let lit = in.color * (0.15 + 0.85 * d) + vec3(0.25 * pow(d, 40.0));
     return output(lit);
 }
 
