@@ -142,6 +142,7 @@ pub struct DataSurface {
     /// to its nearest other point (`loose_spacing`), so a sample's distance to one is counted
     /// less that spacing.
     loose: Option<ImmutableKdTree<f32, u32, 3, 32>>,
+    loose_points: Vec<[f32; 3]>,
     loose_spacing: Vec<f32>,
 }
 
@@ -156,6 +157,8 @@ impl std::fmt::Debug for DataSurface {
 
 /// Where on the data surface a query landed.
 struct Foot {
+    /// The nearest point, relative to the origin.
+    point: Point3,
     dist_sq: f64,
     on_boundary: bool,
     sagitta: f64,
@@ -231,6 +234,7 @@ impl DataSurface {
             tree: RTree::bulk_load(objects),
             rim: RTree::bulk_load(rim),
             loose: (!loose.is_empty()).then(|| ImmutableKdTree::new_from_slice(&loose)),
+            loose_points: loose,
             loose_spacing,
         })
     }
@@ -239,9 +243,15 @@ impl DataSurface {
     /// nearest to it, or `None` when `p`'s nearest data point is on the data's boundary (over a
     /// hole, or beyond the outline).
     pub fn distance(&self, p: Point3) -> Option<f64> {
+        self.closest(p).map(|(d, _)| d)
+    }
+
+    /// [`DataSurface::distance`] with the nearest data point it is measured to (the point a
+    /// straying surface is pulled towards).
+    pub fn closest(&self, p: Point3) -> Option<(f64, Point3)> {
         let p = p - self.origin;
         let foot = self.nearest(p)?;
-        let loose = self.loose.as_ref().map_or(f64::INFINITY, |t| {
+        let loose = self.loose.as_ref().map(|t| {
             let q = [p.x as f32, p.y as f32, p.z as f32];
             let n = t.nearest_one::<SquaredEuclidean>(&q);
             let spacing = self
@@ -249,10 +259,14 @@ impl DataSurface {
                 .get(n.item as usize)
                 .copied()
                 .unwrap_or(0.0);
-            ((n.distance as f64).sqrt() - spacing as f64).max(0.0)
+            let at = self
+                .loose_points
+                .get(n.item as usize)
+                .map_or(p, |&c| Point3::from_array(c.map(f64::from)));
+            (((n.distance as f64).sqrt() - spacing as f64).max(0.0), at)
         });
-        if loose * loose < foot.dist_sq {
-            return Some(loose);
+        if let Some((d, at)) = loose.filter(|(d, _)| d * d < foot.dist_sq) {
+            return Some((d, at + self.origin));
         }
         if foot.on_boundary {
             return None;
@@ -261,8 +275,12 @@ impl DataSurface {
             .rim
             .nearest_neighbor(&p.to_array())
             .map_or(f64::INFINITY, |r| r.distance_2(&p.to_array()));
-        (rim > RIM_FACTOR * RIM_FACTOR * foot.dist_sq)
-            .then(|| (foot.dist_sq.sqrt() - foot.sagitta).max(0.0))
+        (rim > RIM_FACTOR * RIM_FACTOR * foot.dist_sq).then(|| {
+            (
+                (foot.dist_sq.sqrt() - foot.sagitta).max(0.0),
+                foot.point + self.origin,
+            )
+        })
     }
 
     /// The distance of every one of `samples` to the data ([`DataSurface::distance`]).
@@ -292,6 +310,7 @@ impl DataSurface {
             Feature::Vertex(k) => mask & (1 << (3 + k)) != 0,
         };
         Some(Foot {
+            point,
             dist_sq: (p - point).length_squared(),
             on_boundary,
             sagitta: t.sagitta as f64,
@@ -436,6 +455,24 @@ mod tests {
         // Beyond the outline the nearest point is on a boundary edge: left out.
         assert_eq!(s.distance(Point3::new(2.0, 0.5, 0.1)), None);
         assert_eq!(s.distance(Point3::new(-1.0, -1.0, 0.0)), None);
+    }
+
+    /// The pull target of a sample is the data point its distance is measured to: below it on
+    /// the square, a loose point for a sample nearer to that, none over the rim.
+    #[test]
+    fn closest_data_point_of_a_sample() {
+        let s = DataSurface::of_mesh(&square()).expect("faces");
+        let (d, q) = s.closest(Point3::new(0.3, 0.6, 0.1)).expect("over data");
+        assert!((d - 0.1).abs() < 1e-6 && (q - Point3::new(0.3, 0.6, 0.0)).length() < 1e-6);
+        assert_eq!(s.closest(Point3::new(2.0, 0.5, 0.1)), None);
+        let mut p = square().positions().to_vec();
+        p.push(Point3::new(0.5, 0.5, 1.0));
+        let with_loose = PolyMesh::try_new(p, vec![[0u32, 1, 2], [0, 2, 3]]).expect("valid");
+        let s = DataSurface::of_mesh(&with_loose).expect("faces");
+        let (_, q) = s
+            .closest(Point3::new(0.5, 0.5, 0.9))
+            .expect("near the loose point");
+        assert!((q - Point3::new(0.5, 0.5, 1.0)).length() < 1e-6, "{q:?}");
     }
 
     #[test]

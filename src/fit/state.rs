@@ -64,14 +64,16 @@ impl FitState {
     }
 
     /// Measures the surface → data distances of `samples` of the current surface and returns
-    /// them (`None` over a hole; empty when no reference is set).
-    pub(crate) fn measure_back(&mut self, samples: &[Point3]) -> Vec<Option<f64>> {
+    /// them with the nearest data point of each (`None` over a hole; empty when no reference
+    /// is set).
+    pub(crate) fn measure_back(&mut self, samples: &[Point3]) -> Vec<Option<(f64, Point3)>> {
         let Some(reference) = &self.reference else {
             return Vec::new();
         };
-        let distances = reference.distances(samples);
+        let closest: Vec<_> = samples.iter().map(|&p| reference.closest(p)).collect();
+        let distances: Vec<Option<f64>> = closest.iter().map(|c| c.map(|(d, _)| d)).collect();
         self.back = Some(BackStats::of(&distances, self.diagonal));
-        distances
+        closest
     }
 
     /// The distance to the data of every one of `points` (points of the fitted surface, such
