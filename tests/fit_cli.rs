@@ -4,7 +4,6 @@
 mod common;
 
 use common::{data_file, geofit, geofit_ok, read_json, REPORT_NUMBERS};
-use std::process::Command;
 
 #[test]
 fn fit_writes_report_cage_and_limit() {
@@ -116,35 +115,50 @@ fn the_page_sample_converges_both_ways_with_the_defaults() {
     let preset = first["preset"].as_object().expect("preset");
     assert_eq!(preset.keys().collect::<Vec<_>>(), ["scheme"]);
     let file = root.join(first["file"].as_str().expect("file name"));
-    let tol_max = geofit::fit::SubdivFitOptions::DEFAULT_TOLERANCES
-        .max_pct
-        .expect("an E_max tolerance");
     let json = std::env::temp_dir().join(format!("geofit-sample-{}.json", std::process::id()));
     for scheme in ["loop", "catmull-clark", "doo-sabin"] {
-        common::run_ok(Command::new(env!("CARGO_BIN_EXE_geofit")).args([
-            "fit",
-            file.to_str().expect("utf-8"),
-            "--scheme",
-            scheme,
-            "-q",
-            "--json",
-            json.to_str().expect("utf-8"),
-        ]));
-        let report: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&json).expect("report")).expect("JSON");
-        assert_eq!(report["status"], "converged", "{scheme}");
+        let report = fit_with_defaults(&file, scheme, &json);
         let last = report["history"]
             .as_array()
             .and_then(|h| h.last())
             .expect("iterations");
         let back = last["e_back_max_pct"].as_f64().expect("E_back measured");
-        assert!(
-            back <= geofit::fit::BACK_TOLERANCE_FACTOR * tol_max,
-            "{scheme}: E_back {back} %"
-        );
-        assert!(report["e_max_pct"].as_f64().expect("E_max") <= tol_max);
+        assert_converged_both_ways(&report, back, scheme);
     }
     std::fs::remove_file(&json).ok();
+}
+
+/// `geofit fit FILE --scheme SCHEME` with every other setting at its default, its report
+/// written to `json` and read back.
+fn fit_with_defaults(
+    file: &std::path::Path,
+    scheme: &str,
+    json: &std::path::Path,
+) -> serde_json::Value {
+    geofit_ok(&[
+        "fit",
+        file.to_str().expect("utf-8"),
+        "--scheme",
+        scheme,
+        "-q",
+        "--json",
+        json.to_str().expect("utf-8"),
+    ]);
+    read_json(json)
+}
+
+/// A fit at the default tolerances converged both ways: status, E_max within its tolerance and
+/// `back` (E_back max %) within the surface → data bound.
+fn assert_converged_both_ways(report: &serde_json::Value, back: f64, scheme: &str) {
+    let tol_max = geofit::fit::SubdivFitOptions::DEFAULT_TOLERANCES
+        .max_pct
+        .expect("an E_max tolerance");
+    assert_eq!(report["status"], "converged", "{scheme}: E_back {back} %");
+    assert!(
+        back <= geofit::fit::BACK_TOLERANCE_FACTOR * tol_max,
+        "{scheme}: E_back {back} %"
+    );
+    assert!(report["e_max_pct"].as_f64().expect("E_max") <= tol_max);
 }
 
 /// `--fem` writes the FEM quad mesh (MSH, or OBJ quads for `.obj`) and prints its quality; the
@@ -239,28 +253,11 @@ fn a_web_across_a_gap_of_the_data_is_pulled_onto_it() {
         eprintln!("skipped: no {}", cow.display());
         return;
     }
-    let tol_max = geofit::fit::SubdivFitOptions::DEFAULT_TOLERANCES
-        .max_pct
-        .expect("an E_max tolerance");
     let json = std::env::temp_dir().join(format!("geofit-cow-{}.json", std::process::id()));
     for scheme in ["loop", "doo-sabin"] {
-        common::geofit_ok(&[
-            "fit",
-            cow.to_str().expect("utf-8"),
-            "--scheme",
-            scheme,
-            "-q",
-            "--json",
-            json.to_str().expect("utf-8"),
-        ]);
-        let report = common::read_json(&json);
+        let report = fit_with_defaults(&cow, scheme, &json);
         let back = report["e_back_max_pct"].as_f64().expect("E_back measured");
-        assert_eq!(report["status"], "converged", "{scheme}: E_back {back} %");
-        assert!(
-            back <= geofit::fit::BACK_TOLERANCE_FACTOR * tol_max,
-            "{scheme}: E_back {back} %"
-        );
-        assert!(report["e_max_pct"].as_f64().expect("E_max") <= tol_max);
+        assert_converged_both_ways(&report, back, scheme);
     }
     std::fs::remove_file(&json).ok();
 }
