@@ -29,6 +29,7 @@ mod stats;
 mod strays;
 mod subdiv;
 mod surface;
+mod surfels;
 
 pub use accel::Acceleration;
 pub use curve::{

@@ -3,14 +3,16 @@
 //! is to the surface; a surface can hold every data point and still have sheets and spikes where
 //! no data point pulls on it (SPEC §6). This module measures those.
 //!
-//! The data surface is the data's triangles (the input mesh, or the mesh reconstructed from
-//! bare points), in an R-tree (`rstar`) whose nearest-neighbour query is exact. A sample whose
+//! The data surface is the data's triangles (the input mesh), in an R-tree (`rstar`) whose
+//! nearest-neighbour query is exact. Bare points are measured to their own local planes
+//! ([`super::surfels`]), and the mesh reconstructed from them only says where they have holes. A sample whose
 //! nearest data point lies on a boundary edge of the data, or whose nearest boundary point is
 //! hardly farther than its nearest data point ([`RIM_FACTOR`]), spans a hole or lies beyond the
 //! data's outline — a surface may span holes (SPEC §6) — and is left out of the statistics. On a
 //! closed mesh nothing is left out. The data's triangles are flat where the scanned surface is
 //! not, so each distance is taken less the triangle's own [`sagitta`].
 
+use super::surfels::Surfels;
 use crate::geom::{Point3, Vec3};
 use crate::mesh::PolyMesh;
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
@@ -144,6 +146,9 @@ pub struct DataSurface {
     loose: Option<ImmutableKdTree<f32, u32, 3, 32>>,
     loose_points: Vec<[f32; 3]>,
     loose_spacing: Vec<f32>,
+    /// Bare points' discs ([`DataSurface::of_points`]): distances are measured to them, the
+    /// triangles only tell holes.
+    surfels: Option<Surfels>,
 }
 
 impl std::fmt::Debug for DataSurface {
@@ -236,7 +241,20 @@ impl DataSurface {
             loose: (!loose.is_empty()).then(|| ImmutableKdTree::new_from_slice(&loose)),
             loose_points: loose,
             loose_spacing,
+            surfels: None,
         })
+    }
+
+    /// The surface of bare `points`: each point's disc in the plane of its neighbours
+    /// ([`Surfels`]), with `reconstruction` (the mesh made of the points) telling where the
+    /// points have holes or end. A reconstruction is coarser than the points and lies off
+    /// them, so distances to its triangles would count a surface on the points as straying.
+    /// `None` without points or without faces.
+    pub fn of_points(points: &[Point3], reconstruction: &PolyMesh) -> Option<DataSurface> {
+        let mut surface = DataSurface::of_mesh(reconstruction)?;
+        let local: Vec<Point3> = points.iter().map(|&p| p - surface.origin).collect();
+        surface.surfels = Some(Surfels::new(&local)?);
+        Some(surface)
     }
 
     /// The distance from `p` to the data surface, less the [`sagitta`] of the data triangle
@@ -275,12 +293,16 @@ impl DataSurface {
             .rim
             .nearest_neighbor(&p.to_array())
             .map_or(f64::INFINITY, |r| r.distance_2(&p.to_array()));
-        (rim > RIM_FACTOR * RIM_FACTOR * foot.dist_sq).then(|| {
-            (
-                (foot.dist_sq.sqrt() - foot.sagitta).max(0.0),
-                foot.point + self.origin,
-            )
-        })
+        if rim <= RIM_FACTOR * RIM_FACTOR * foot.dist_sq {
+            return None;
+        }
+        if let Some(surfels) = &self.surfels {
+            return surfels.closest(p).map(|(d, at)| (d, at + self.origin));
+        }
+        Some((
+            (foot.dist_sq.sqrt() - foot.sagitta).max(0.0),
+            foot.point + self.origin,
+        ))
     }
 
     /// The distance of every one of `samples` to the data ([`DataSurface::distance`]).

@@ -912,16 +912,24 @@ impl FitSpec {
     }
 
     /// The data's surface a B-spline surface fit's E_back is measured against: the data's
-    /// faces, else the mesh of the points that a subdivision fit starts from (the range grid's
-    /// triangles for a range scan, so the same E_back for both). `None` when no mesh can be
-    /// made of the points: the fit then reports no E_back, and fits on.
+    /// faces, else the points' discs with the holes of the mesh that a subdivision fit starts
+    /// from (the range grid's triangles for a range scan), as a subdivision fit measures it.
+    /// `None` when no mesh can be made of the points: the fit then reports no E_back, and
+    /// fits on.
     fn back_reference(&self, data: &FitData) -> Option<DataSurface> {
         if !data.mesh.is_point_cloud() {
             return DataSurface::of_mesh(data.mesh);
         }
         let grid = data.grid.filter(|_| self.use_grid);
-        let mesh = reconstruct(data.mesh.positions(), grid, &self.cloud_options()).ok()?;
-        DataSurface::of_mesh(&mesh.mesh)
+        let made = reconstruct(data.mesh.positions(), grid, &self.cloud_options()).ok()?;
+        let inliers: Vec<Point3> = data
+            .mesh
+            .positions()
+            .iter()
+            .zip(&made.inlier)
+            .filter_map(|(&p, &keep)| keep.then_some(p))
+            .collect();
+        DataSurface::of_points(&inliers, &made.mesh)
     }
 
     fn cloud_options(&self) -> ReconstructOptions {

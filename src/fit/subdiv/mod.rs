@@ -137,8 +137,6 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// the moves (see [`SubdivFitter::back_rows`]).
     pulls: Vec<(SurfaceParam, Point3)>,
     pull_weight: f64,
-    /// Whether the moves pull straying samples towards the reference at all.
-    pull_back: bool,
     /// Every data point's weight in the moves (see [`SubdivFitter::adapt_point_weights`]).
     point_weights: Vec<f64>,
     accel: Accelerator,
@@ -193,7 +191,6 @@ impl<S: ControlSurface> SubdivFitter<S> {
             strays: Vec::new(),
             pulls: Vec::new(),
             pull_weight: 0.0,
-            pull_back: false,
             point_weights: vec![1.0; data_points.len()],
             accel: Accelerator::new(options.acceleration),
             index,
@@ -650,8 +647,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         // Pull (the CG moves take the rows) only once the data → surface errors meet E_max:
         // before, refinement and the data shape the surface, and a pull against the data's own
         // (a sharp rim) costs E_max.
-        let pull = self.pull_back
-            && matches!(self.options.acceleration, Acceleration::Cg { .. })
+        let pull = matches!(self.options.acceleration, Acceleration::Cg { .. })
             && self
                 .state
                 .tolerances()
@@ -672,14 +668,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .collect();
     }
 
-    /// Measures the surface → data distance against `reference`. With `pull`, the moves also
-    /// pull straying samples towards it ([`SubdivFitter::back_rows`]): right for the data's own
-    /// triangles, wrong for a mesh reconstructed from bare points, which is itself only an
-    /// estimate of the surface (pulled towards one, cheburashka's points with Loop went from
-    /// stalled at E_back 2.05 % to stalled at 11.6 % after 111 iterations).
-    pub fn with_reference(mut self, reference: Option<DataSurface>, pull: bool) -> Self {
+    /// Measures the surface → data distance against `reference`, and the moves pull straying
+    /// samples towards it ([`SubdivFitter::back_rows`]). For bare points the reference is the
+    /// points' own discs ([`DataSurface::of_points`]), not the mesh reconstructed from them:
+    /// that mesh lies off the points, and pulled towards it cheburashka's points with Loop went
+    /// from stalled at E_back 2.05 % to stalled at 11.6 % after 111 iterations.
+    pub fn with_reference(mut self, reference: Option<DataSurface>) -> Self {
         self.state.set_reference(reference);
-        self.pull_back = pull;
         self.measure_back();
         self
     }

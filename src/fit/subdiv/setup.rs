@@ -213,10 +213,13 @@ pub(crate) fn build_subdiv_fitter(
         (points, std::borrow::Cow::Borrowed(data), None)
     };
     let start = control_mesh(&mesh, control, initial, features, scheme)?;
-    let own_faces = reconstruction.is_none();
+    let reference = match reconstruction {
+        None => DataSurface::of_mesh(&mesh),
+        Some(_) => DataSurface::of_points(&points, &mesh),
+    };
     let mut fitter =
         SubdivFitter::with_creases(&points, start.mesh, &start.creases, scheme, options)?
-            .with_reference(DataSurface::of_mesh(&mesh), own_faces);
+            .with_reference(reference);
     fitter.log_mut().set_reconstruction(reconstruction);
     fitter.log_mut().set_simplification(start.simplified);
     fitter.log_mut().set_creases(start.crease_report);
