@@ -190,7 +190,7 @@ pub fn reconstruct(
             min: MIN_POINTS,
         });
     }
-    let frame = normals::frame(kept.iter().copied());
+    let frame = crate::geom::principal_frame(kept.iter().copied());
     let extent = frame.values[2].max(0.0).sqrt();
     if extent == 0.0 {
         return Err(ReconstructError::Degenerate {
@@ -244,7 +244,7 @@ fn inliers(spacing: &[f64], ratio: Option<f64>) -> Vec<bool> {
 /// A kd-tree over `points` and their PCA normals, oriented consistently.
 fn oriented_normals(
     points: &[Point3],
-    frame: &normals::Frame,
+    frame: &crate::geom::Frame,
     k: usize,
 ) -> (Neighbours, Vec<Vec3>) {
     let tree = Neighbours::new(points);
@@ -254,7 +254,7 @@ fn oriented_normals(
 }
 
 /// Open or closed, from how the oriented normals sit against the best-fit plane.
-fn detect_kind(normals: &[Vec3], frame: &normals::Frame) -> SurfaceKind {
+fn detect_kind(normals: &[Vec3], frame: &crate::geom::Frame) -> SurfaceKind {
     let axis = frame.axes[0];
     let up = normals.iter().filter(|v| v.dot(axis) > 0.0).count() as f64 / normals.len() as f64;
     if up.max(1.0 - up) >= OPEN_FRACTION {
@@ -269,7 +269,7 @@ fn open_mesh(
     grid: Option<&RangeGrid>,
     inlier: &[bool],
     spacing: &[f64],
-    frame: &normals::Frame,
+    frame: &crate::geom::Frame,
     options: &ReconstructOptions,
 ) -> Result<PolyMesh, ReconstructError> {
     let tris = match grid {
@@ -300,7 +300,7 @@ fn closed_mesh(
     let mut cell = options.cell_size * median(&kept_spacing);
     if cell <= 0.0 {
         // Mostly duplicated points: fall back to a hundredth of the spread.
-        cell = normals::frame(kept.iter().copied()).values[2].sqrt() * 1e-2;
+        cell = crate::geom::principal_frame(kept.iter().copied()).values[2].sqrt() * 1e-2;
     }
     let (positions, tris) = closed::contour(kept, normals, tree, cell, BAND_CELLS);
     let tris = cleanup::manifold_part(tris, positions.len());

@@ -3,40 +3,10 @@
 //! neighbour graph (Hoppe et al. 1992, "Surface reconstruction from unorganized points").
 
 use super::neighbours::Neighbours;
-use crate::geom::symmetric_eigen;
+use crate::geom::principal_frame;
 use crate::geom::{Point3, Vec3};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
-
-/// The principal frame of a set of points: centroid, eigenvalues (ascending) and axes.
-pub(super) struct Frame {
-    pub(super) centroid: Point3,
-    pub(super) values: [f64; 3],
-    pub(super) axes: [Vec3; 3],
-}
-
-/// Principal frame of `points` (not empty).
-pub(super) fn frame(points: impl Iterator<Item = Point3> + Clone) -> Frame {
-    let (sum, n) = points
-        .clone()
-        .fold((Vec3::ZERO, 0usize), |(s, n), p| (s + p, n + 1));
-    let centroid = sum / n.max(1) as f64;
-    let mut m = [[0.0; 3]; 3];
-    for p in points {
-        let d = (p - centroid).to_array();
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] += d[i] * d[j];
-            }
-        }
-    }
-    let (values, axes) = symmetric_eigen(m);
-    Frame {
-        centroid,
-        values,
-        axes,
-    }
-}
 
 /// Unoriented unit normals: the least principal axis of each point's `k` nearest neighbours.
 /// Where a neighbourhood is degenerate (coincident points), `fallback` is used.
@@ -50,7 +20,7 @@ pub(super) fn pca_normals(
         .iter()
         .map(|&p| {
             let near = tree.nearest(p, k);
-            let f = frame(near.iter().map(|&(i, _)| points[i]));
+            let f = principal_frame(near.iter().map(|&(i, _)| points[i]));
             if f.values[1] > 0.0 && f.axes[0] != Vec3::ZERO {
                 f.axes[0]
             } else {

@@ -2,8 +2,8 @@
 //! of the points projected onto their best-fit plane, then cut the triangles that span holes
 //! or run outside the scanned outline (edges long against the local point spacing).
 
-use super::normals::Frame;
 use super::ReconstructError;
+use crate::geom::Frame;
 use crate::geom::Point3;
 use crate::io::RangeGrid;
 use spade::{DelaunayTriangulation, Point2, Triangulation};

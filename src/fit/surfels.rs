@@ -10,7 +10,7 @@
 //! are measured from the points themselves. The reconstruction still says where the data has
 //! holes (`DataSurface::of_points`).
 
-use crate::geom::{symmetric_eigen, Point3, Vec3};
+use crate::geom::{principal_frame, Frame, Point3, Vec3};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use std::num::NonZero;
@@ -110,20 +110,7 @@ fn at(centres: &[[f32; 3]], i: u32) -> Point3 {
 
 /// The least principal axis of `points`, or zero when they span no plane.
 fn plane_normal(points: impl Iterator<Item = Point3> + Clone) -> Vec3 {
-    let (sum, count) = points
-        .clone()
-        .fold((Vec3::ZERO, 0usize), |(s, n), p| (s + p, n + 1));
-    let centroid = sum / count.max(1) as f64;
-    let mut m = [[0.0; 3]; 3];
-    for p in points {
-        let d = (p - centroid).to_array();
-        for (i, row) in m.iter_mut().enumerate() {
-            for (j, cell) in row.iter_mut().enumerate() {
-                *cell += d[i] * d[j];
-            }
-        }
-    }
-    let (values, axes) = symmetric_eigen(m);
+    let Frame { values, axes, .. } = principal_frame(points);
     if values[1] > 1e-12 * values[2] && values[2] > 0.0 && axes[0].is_finite() {
         axes[0]
     } else {

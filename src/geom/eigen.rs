@@ -1,7 +1,41 @@
 //! Eigen-decomposition of symmetric 3×3 matrices (cyclic Jacobi), for principal directions of
 //! point clouds and neighbourhoods.
 
-use crate::geom::Vec3;
+use crate::geom::{Point3, Vec3};
+
+/// The principal frame of a set of points: centroid, eigenvalues of the scatter matrix
+/// (ascending) and their unit axes (the first is the normal of a best-fit plane).
+pub struct Frame {
+    /// The mean of the points.
+    pub centroid: Point3,
+    /// Eigenvalues of the scatter matrix Σ (p − c)(p − c)ᵀ, ascending.
+    pub values: [f64; 3],
+    /// Their unit eigenvectors (zero where the decomposition gave none).
+    pub axes: [Vec3; 3],
+}
+
+/// Principal frame of `points` (the centroid is the origin for none).
+pub fn principal_frame(points: impl Iterator<Item = Point3> + Clone) -> Frame {
+    let (sum, n) = points
+        .clone()
+        .fold((Vec3::ZERO, 0usize), |(s, n), p| (s + p, n + 1));
+    let centroid = sum / n.max(1) as f64;
+    let mut m = [[0.0; 3]; 3];
+    for p in points {
+        let d = (p - centroid).to_array();
+        for (i, row) in m.iter_mut().enumerate() {
+            for (j, cell) in row.iter_mut().enumerate() {
+                *cell += d[i] * d[j];
+            }
+        }
+    }
+    let (values, axes) = symmetric_eigen(m);
+    Frame {
+        centroid,
+        values,
+        axes,
+    }
+}
 
 /// Eigenvalues (ascending) and unit eigenvectors of the symmetric matrix `m` (row-major).
 pub fn symmetric_eigen(m: [[f64; 3]; 3]) -> ([f64; 3], [Vec3; 3]) {

@@ -9,7 +9,7 @@ mod order;
 
 pub use aabb::Aabb;
 pub use coords::{check_coordinates, find_strays, BadCoordinate, COORDINATE_LIMIT};
-pub use eigen::symmetric_eigen;
+pub use eigen::{principal_frame, symmetric_eigen, Frame};
 pub use nearest::{ClosestPoint, Nearest, NewtonOptions};
 pub(crate) use order::{median, quantile};
 
