@@ -268,6 +268,14 @@ impl DataSurface {
     /// straying surface is pulled towards).
     pub fn closest(&self, p: Point3) -> Option<(f64, Point3)> {
         let p = p - self.origin;
+        if let (Some(surfels), 0, None) = (&self.surfels, self.rim.size(), &self.loose) {
+            // A closed reconstruction has no hole to tell: only the discs matter.
+            return p
+                .is_finite()
+                .then(|| surfels.closest(p))
+                .flatten()
+                .map(|(d, at)| (d, at + self.origin));
+        }
         let foot = self.nearest(p)?;
         let loose = self.loose.as_ref().map(|t| {
             let q = [p.x as f32, p.y as f32, p.z as f32];
