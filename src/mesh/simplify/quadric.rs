@@ -39,6 +39,7 @@ impl Quadric {
     }
 
     /// `A v`.
+    #[inline]
     fn mul(&self, v: Vec3) -> Vec3 {
         Vec3::new(
             self.a00 * v.x + self.a01 * v.y + self.a02 * v.z,
@@ -49,6 +50,7 @@ impl Quadric {
 
     /// The error at `p`; never negative (rounding is clamped). Written out, as the simplifier
     /// evaluates it for every edge in every pass.
+    #[inline]
     pub(super) fn eval(&self, p: Point3) -> f64 {
         let (x, y, z) = (p.x, p.y, p.z);
         let quadratic = self.a00 * x * x
@@ -60,6 +62,7 @@ impl Quadric {
 
     /// The point minimising the error, or `None` when A is (nearly) singular: `-A⁻¹b` from the
     /// six cofactors of the symmetric A, whose determinant also serves the singularity test.
+    #[inline]
     pub(super) fn minimizer(&self) -> Option<Point3> {
         let (a00, a01, a02, a11, a12, a22) =
             (self.a00, self.a01, self.a02, self.a11, self.a12, self.a22);
@@ -85,6 +88,7 @@ impl Quadric {
 
     /// The point minimising the error on the segment `p`–`q` (closed form of a 1D quadratic;
     /// along a direction of no curvature, the lower end).
+    #[inline]
     pub(super) fn minimizer_on_segment(&self, p: Point3, q: Point3) -> Point3 {
         let d = q - p;
         // Q(p + t d) = t² dᵀAd + 2t (dᵀAp + bᵀd) + const.
@@ -105,6 +109,7 @@ const MAX_OPTIMUM_OFFSET: f64 = 2.0;
 /// The best position for the vertex that replaces edge `pu`–`pv` under the summed quadric `q`,
 /// and its error: the optimum of `q` when it is well defined and near the edge, else the
 /// optimum on the edge.
+#[inline]
 pub(super) fn placement(q: &Quadric, pu: Point3, pv: Point3) -> (Point3, f64) {
     let mid = (pu + pv) * 0.5;
     let reach_sq = MAX_OPTIMUM_OFFSET * MAX_OPTIMUM_OFFSET * pu.distance_squared(pv);
@@ -116,6 +121,7 @@ pub(super) fn placement(q: &Quadric, pu: Point3, pv: Point3) -> (Point3, f64) {
 }
 
 impl AddAssign for Quadric {
+    #[inline]
     fn add_assign(&mut self, o: Quadric) {
         self.a00 += o.a00;
         self.a01 += o.a01;
@@ -130,6 +136,7 @@ impl AddAssign for Quadric {
 
 impl std::ops::Add for Quadric {
     type Output = Quadric;
+    #[inline]
     fn add(mut self, o: Quadric) -> Quadric {
         self += o;
         self

@@ -10,19 +10,14 @@
 //! repair to leave it to the data only.
 
 use super::engine::Engine;
-use crate::mesh::repair::clean::has_area;
 use crate::mesh::repair::{RepairOptions, RepairReport};
 
 /// The report of a repair that found nothing to do, or `None` when the mesh needs repair.
 pub(super) fn clean_report(e: &Engine) -> Option<RepairReport> {
-    if !(0..e.num_faces()).all(|f| face_is_sound(e, f)) {
+    if !e.faces_are_sound() {
         return None;
     }
-    let mut around = Vec::new();
-    if !(0..e.num_vertices() as u32).all(|v| single_fan(e, v, &mut around)) {
-        return None;
-    }
-    let sizes = component_sizes(e);
+    let sizes = component_sizes_of_fans(e)?;
     let largest = sizes.iter().copied().max().unwrap_or(0);
     let tiny = RepairOptions::default().data_only_faces;
     if sizes.iter().any(|&s| s <= tiny && s < largest) {
@@ -39,17 +34,6 @@ pub(super) fn clean_report(e: &Engine) -> Option<RepairReport> {
     }
     report.summarise();
     Some(report)
-}
-
-/// Whether face `f` has three distinct corners and an area.
-fn face_is_sound(e: &Engine, f: usize) -> bool {
-    let t = e.face(f);
-    if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-        return false;
-    }
-    let [a, b, c] = t.map(|v| e.pos(v));
-    let sides = (b - a).length_squared() + (c - b).length_squared() + (a - c).length_squared();
-    has_area((b - a).cross(c - a).length(), sides)
 }
 
 /// Whether the faces of `v` form one fan with each side once (see the module docs);
@@ -96,31 +80,42 @@ fn single_fan(e: &Engine, v: u32, around: &mut Vec<(u32, u32)>) -> bool {
     open && count == d
 }
 
-/// The number of faces of each connected component (faces joined through shared vertices,
-/// which in a manifold with single fans is through shared edges).
-fn component_sizes(e: &Engine) -> Vec<usize> {
-    let mut parent: Vec<u32> = (0..e.num_vertices() as u32).collect();
-    let root = |parent: &mut Vec<u32>, mut v: u32| {
-        while parent[v as usize] != v {
-            let up = parent[parent[v as usize] as usize];
-            parent[v as usize] = up;
-            v = up;
+/// The number of faces of each connected component, or `None` when the faces of some vertex
+/// do not form one fan. One sweep over the vertices: each is joined to the next corners of its
+/// faces, which joins every side of every face, and a component's faces are its corners over 3.
+fn component_sizes_of_fans(e: &Engine) -> Option<Vec<usize>> {
+    let n = e.num_vertices();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut around = Vec::new();
+    for v in 0..n as u32 {
+        if !single_fan(e, v, &mut around) {
+            return None;
         }
-        v
-    };
-    for f in 0..e.num_faces() {
-        let t = e.face(f);
-        let r0 = root(&mut parent, t[0]);
-        for &w in &t[1..] {
-            let r = root(&mut parent, w);
-            parent[r as usize] = r0;
+        // Each inner side is the next side of both its ends; a side on the boundary only of
+        // the end it leaves (it is no face's previous side there).
+        for &(next, _) in &around {
+            if next > v || !around.iter().any(|c| c.1 == next) {
+                let (r, s) = (root(&mut parent, v), root(&mut parent, next));
+                parent[s as usize] = r;
+            }
         }
     }
-    let mut count = vec![0usize; e.num_vertices()];
-    for f in 0..e.num_faces() {
-        let r = root(&mut parent, e.face(f)[0]);
-        count[r as usize] += 1;
+    let mut corners = vec![0usize; n];
+    for v in 0..n as u32 {
+        let r = root(&mut parent, v);
+        corners[r as usize] += e.faces_of(v).len();
     }
-    count.retain(|&c| c > 0);
-    count
+    corners.retain(|&c| c > 0);
+    corners.iter_mut().for_each(|c| *c /= 3);
+    Some(corners)
+}
+
+/// The representative of `v`'s set, halving the path on the way.
+fn root(parent: &mut [u32], mut v: u32) -> u32 {
+    while parent[v as usize] != v {
+        let up = parent[parent[v as usize] as usize];
+        parent[v as usize] = up;
+        v = up;
+    }
+    v
 }
