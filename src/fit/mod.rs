@@ -47,7 +47,8 @@ pub use stats::{ErrorStats, IterationRecord, Tolerances};
 pub use strays::StrayPoints;
 pub use subdiv::{
     default_initial_count, initial_control, surface_of, ControlSurface, CreaseReport,
-    ReconstructionReport, SubdivFitOptions, SubdivFitter, Weighting,
+    FootPointBench, FootPointTiming, ReconstructionReport, SubdivFitOptions, SubdivFitter,
+    Weighting,
 };
 pub use surface::{
     detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, CreaseKnot,

@@ -865,7 +865,7 @@ impl FitSpec {
         })
     }
 
-    fn subdiv_options(&self) -> SubdivFitOptions {
+    pub(crate) fn subdiv_options(&self) -> SubdivFitOptions {
         let d = SubdivFitOptions::DEFAULT;
         SubdivFitOptions {
             tolerances: self.tolerances(),

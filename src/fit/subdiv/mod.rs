@@ -2,12 +2,14 @@
 //! vectors, weighted control-point moves, acceleration with damping, and local refinement.
 
 mod control;
+mod feet;
 mod frozen;
 mod index;
 mod options;
 mod setup;
 
 pub use control::surface_of;
+pub use feet::{FootPointBench, FootPointTiming};
 pub use options::{SubdivFitOptions, Weighting};
 pub(crate) use setup::build_subdiv_fitter;
 pub(crate) use setup::find_creases;
@@ -261,11 +263,9 @@ impl<S: ControlSurface> SubdivFitter<S> {
         let opts = self.newton;
         let mut feet = Vec::with_capacity(self.state.data().len());
         for (i, &p) in self.state.data().iter().enumerate() {
-            let start = self
-                .index
-                .nearest(p)
+            let foot = feet::cold_foot(&self.surface, &self.index, p, &opts)
                 .ok_or(FitError::NoSurfaceNear { point: i })?;
-            feet.push(self.surface.closest_point_from(p, start, &opts));
+            feet.push(foot);
         }
         self.feet = feet;
         self.update_errors();
@@ -277,20 +277,10 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// the better of the two results is kept.
     fn update_feet(&mut self, previous: &[FootPoint]) {
         let opts = self.newton;
-        let slack = 1e-3 * self.state.diagonal();
+        let slack = feet::WARM_SLACK * self.state.diagonal();
         for (i, &p) in self.state.data().iter().enumerate() {
-            let prev = previous[i];
-            let mut foot = self.surface.closest_point_from(p, prev.param, &opts);
-            let grew = foot.dist_sq.sqrt() > 2.0 * prev.dist_sq.sqrt() + slack;
-            if !foot.converged || grew {
-                if let Some(start) = self.index.nearest(p) {
-                    let other = self.surface.closest_point_from(p, start, &opts);
-                    if other.dist_sq < foot.dist_sq {
-                        foot = other;
-                    }
-                }
-            }
-            self.feet[i] = foot;
+            self.feet[i] =
+                feet::warm_foot(&self.surface, &self.index, p, &previous[i], &opts, slack);
         }
         self.update_errors();
     }
