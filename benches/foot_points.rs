@@ -10,7 +10,7 @@
 //! Run: `cargo bench --bench foot_points [-- SCHEME...]` (schemes: loop, catmull-clark,
 //! doo-sabin; all three by default). The data directory is `GEOFIT_DATA`, else
 //! `../shared/data` beside the repository, else `/work/shared/data`. Each figure is the best
-//! of `REPEATS` passes, in thread CPU time where Linux gives it (so a busy machine does not
+//! of `REPEATS` passes, in thread CPU time where the system gives it (so a busy machine does not
 //! lower it), and wall time otherwise. A plain timing loop (no criterion) keeps the
 //! dev-dependencies and the build small.
 
@@ -21,13 +21,22 @@ use std::time::Instant;
 /// Timed passes of each kind; the best counts.
 const REPEATS: usize = 7;
 
-/// CPU time of this thread in seconds (Linux), `None` elsewhere.
+/// CPU time of this thread in seconds (`CLOCK_THREAD_CPUTIME_ID`: nanoseconds, unlike the
+/// scheduler's tick-granular counters in /proc), `None` where there is none.
+#[cfg(unix)]
 fn thread_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
-    let after = &stat[stat.rfind(')')? + 2..];
-    let fields: Vec<&str> = after.split_whitespace().collect();
-    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
+    let mut t = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `t` is a valid timespec for clock_gettime to write.
+    let ok = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) } == 0;
+    ok.then_some(t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9)
+}
+
+#[cfg(not(unix))]
+fn thread_cpu_seconds() -> Option<f64> {
+    None
 }
 
 fn data_dir() -> PathBuf {

@@ -3,7 +3,7 @@
 //! [`FootPointBench`], which times both on a finished fit the way the fit runs them.
 
 use super::index::SurfaceIndex;
-use super::FootPoint;
+use super::{FootPoint, SubdivFitOptions};
 use crate::fit::{FitData, FitError, FitSpec, FitStatus, Fitter};
 use crate::geom::{ClosestPoint, NewtonOptions, Point3};
 use crate::subdiv::{LimitSurface, SubdivSurface, SurfaceParam};
@@ -45,6 +45,40 @@ pub(crate) fn warm_foot<S: ClosestPoint<Param = SurfaceParam>>(
         }
     }
     foot
+}
+
+/// Every point's foot point from the spatial index ([`cold_foot`]). `Err(i)` names a point the
+/// index has nothing near.
+///
+/// Points are visited in data order: scans list their points in a spatially coherent order, so
+/// consecutive searches mostly share patches. (Visiting them grouped by patch was measured
+/// slower: the scattered reads and writes of the points cost more than the patch data they
+/// share.)
+pub(crate) fn cold_feet<S: ClosestPoint<Param = SurfaceParam>>(
+    surface: &S,
+    index: &SurfaceIndex,
+    data: &[Point3],
+    opts: &NewtonOptions,
+) -> Result<Vec<FootPoint>, usize> {
+    data.iter()
+        .enumerate()
+        .map(|(i, &p)| cold_foot(surface, index, p, opts).ok_or(i))
+        .collect()
+}
+
+/// Every point's foot point from its previous one ([`warm_foot`]) into `out`.
+pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam>>(
+    surface: &S,
+    index: &SurfaceIndex,
+    data: &[Point3],
+    previous: &[FootPoint],
+    opts: &NewtonOptions,
+    slack: f64,
+    out: &mut [FootPoint],
+) {
+    for ((o, &p), prev) in out.iter_mut().zip(data).zip(previous) {
+        *o = warm_foot(surface, index, p, prev, opts, slack);
+    }
 }
 
 /// What one timed pass of [`FootPointBench`] did.
@@ -125,22 +159,44 @@ impl FootPointBench {
             .find(|w| w[0].len() == after.len() && w[1] == after && w[0] != w[1])
             .map(|w| w[0].clone());
         let before = moved.unwrap_or_else(|| perturbed(&after, 1e-5 * diagonal));
-        let mut surface = SubdivSurface::try_new(last.scheme(), last.control_mesh().clone())?;
-        let data = fitter.state().data().to_vec();
+        let surface = SubdivSurface::try_new(last.scheme(), last.control_mesh().clone())?;
+        let mut bench = FootPointBench::with_surface(
+            surface,
+            &before,
+            fitter.state().data().to_vec(),
+            diagonal,
+            &options,
+        )?;
+        (bench.iterations, bench.status) = (fitter.log().history().len(), status);
+        Ok(bench)
+    }
+
+    /// Timing passes on `surface` (whose control points are the final ones) for `data`, the
+    /// warm pass starting from the foot points on the control points `before`; `diagonal` is
+    /// the data's bounding-box diagonal and `options` the fit's (index resolution, Newton).
+    pub fn with_surface(
+        mut surface: SubdivSurface,
+        before: &[Point3],
+        data: Vec<Point3>,
+        diagonal: f64,
+        options: &SubdivFitOptions,
+    ) -> Result<FootPointBench, FitError> {
+        let after = surface.control_points().to_vec();
+        if before.len() != after.len() {
+            return Err(FitError::InvalidOption {
+                name: "before",
+                reason: format!("{} control points for {}", before.len(), after.len()),
+            });
+        }
         let per_patch = data.len() as f64 / surface.num_patches().max(1) as f64;
         let resolution = (per_patch.sqrt().ceil() as usize).clamp(1, options.index_resolution);
         let newton = options
             .newton
             .with_step_tol(options.newton.step_tol * diagonal);
-        surface.set_control_points(&before);
+        surface.set_control_points(before);
         let index = SurfaceIndex::build(&surface, resolution);
-        let previous = data
-            .iter()
-            .enumerate()
-            .map(|(i, &p)| {
-                cold_foot(&surface, &index, p, &newton).ok_or(FitError::NoSurfaceNear { point: i })
-            })
-            .collect::<Result<Vec<_>, _>>()?;
+        let previous = cold_feet(&surface, &index, &data, &newton)
+            .map_err(|point| FitError::NoSurfaceNear { point })?;
         surface.set_control_points(&after);
         let index = SurfaceIndex::build(&surface, resolution);
         Ok(FootPointBench {
@@ -149,12 +205,27 @@ impl FootPointBench {
             data,
             newton,
             slack: WARM_SLACK * diagonal,
-            before,
+            before: before.to_vec(),
             after,
             previous,
-            iterations: fitter.log().history().len(),
-            status,
+            iterations: 0,
+            status: FitStatus::Running,
         })
+    }
+
+    /// The final surface.
+    pub fn surface(&self) -> &SubdivSurface {
+        &self.surface
+    }
+
+    /// The control points before the last move (the warm pass starts from their foot points).
+    pub fn control_points_before(&self) -> &[Point3] {
+        &self.before
+    }
+
+    /// The data points.
+    pub fn data(&self) -> &[Point3] {
+        &self.data
     }
 
     /// Number of data points (foot points per pass).
@@ -184,47 +255,42 @@ impl FootPointBench {
     /// One pass of cold foot points: every data point from the spatial index.
     pub fn cold(&self) -> FootPointTiming {
         let start = Instant::now();
-        let mut t = FootPointTiming {
-            points: 0,
-            seconds: 0.0,
-            iterations: 0,
-            unconverged: 0,
-            distance_sum: 0.0,
-        };
-        for &p in &self.data {
-            if let Some(f) = cold_foot(&self.surface, &self.index, p, &self.newton) {
-                tally(&mut t, &f);
-            }
-        }
-        t.seconds = start.elapsed().as_secs_f64();
-        t
+        let feet = cold_feet(&self.surface, &self.index, &self.data, &self.newton);
+        let seconds = start.elapsed().as_secs_f64();
+        summary(feet.as_deref().unwrap_or(&[]), seconds)
     }
 
     /// One pass of warm foot points: every data point from its foot point on the previous
     /// control points.
     pub fn warm(&self) -> FootPointTiming {
+        let mut feet = self.previous.clone();
         let start = Instant::now();
-        let mut t = FootPointTiming {
-            points: 0,
-            seconds: 0.0,
-            iterations: 0,
-            unconverged: 0,
-            distance_sum: 0.0,
-        };
-        for (&p, prev) in self.data.iter().zip(&self.previous) {
-            let f = warm_foot(
-                &self.surface,
-                &self.index,
-                p,
-                prev,
-                &self.newton,
-                self.slack,
-            );
-            tally(&mut t, &f);
-        }
-        t.seconds = start.elapsed().as_secs_f64();
-        t
+        warm_feet(
+            &self.surface,
+            &self.index,
+            &self.data,
+            &self.previous,
+            &self.newton,
+            self.slack,
+            &mut feet,
+        );
+        let seconds = start.elapsed().as_secs_f64();
+        summary(&feet, seconds)
     }
+}
+
+fn summary(feet: &[FootPoint], seconds: f64) -> FootPointTiming {
+    let mut t = FootPointTiming {
+        points: 0,
+        seconds,
+        iterations: 0,
+        unconverged: 0,
+        distance_sum: 0.0,
+    };
+    for f in feet {
+        tally(&mut t, f);
+    }
+    t
 }
 
 fn tally(t: &mut FootPointTiming, f: &FootPoint) {

@@ -261,13 +261,8 @@ impl<S: ControlSurface> SubdivFitter<S> {
     /// Global search: every foot point from the spatial index, then Newton.
     fn search_all_feet(&mut self) -> Result<(), FitError> {
         let opts = self.newton;
-        let mut feet = Vec::with_capacity(self.state.data().len());
-        for (i, &p) in self.state.data().iter().enumerate() {
-            let foot = feet::cold_foot(&self.surface, &self.index, p, &opts)
-                .ok_or(FitError::NoSurfaceNear { point: i })?;
-            feet.push(foot);
-        }
-        self.feet = feet;
+        self.feet = feet::cold_feet(&self.surface, &self.index, self.state.data(), &opts)
+            .map_err(|point| FitError::NoSurfaceNear { point })?;
         self.update_errors();
         Ok(())
     }
@@ -278,10 +273,15 @@ impl<S: ControlSurface> SubdivFitter<S> {
     fn update_feet(&mut self, previous: &[FootPoint]) {
         let opts = self.newton;
         let slack = feet::WARM_SLACK * self.state.diagonal();
-        for (i, &p) in self.state.data().iter().enumerate() {
-            self.feet[i] =
-                feet::warm_foot(&self.surface, &self.index, p, &previous[i], &opts, slack);
-        }
+        feet::warm_feet(
+            &self.surface,
+            &self.index,
+            self.state.data(),
+            previous,
+            &opts,
+            slack,
+            &mut self.feet,
+        );
         self.update_errors();
     }
 
