@@ -65,6 +65,65 @@ const LOOP_BOX: [[f64; 15]; 12] = [
     [0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
 ];
 
+/// The power form Σ c_ab u^a v^b over a ≤ N − 1 and b ≤ N − 1 (`TRIANGLE`: a + b ≤ N − 1),
+/// coefficients grouped by `a` as in [`PowerBasis::exps`], with first and second derivatives.
+/// Missing coefficients count as zero.
+#[inline(always)]
+fn eval_power<const N: usize, const TRIANGLE: bool>(c: &[Vec3], u: f64, v: f64) -> LimitEval {
+    // x^k, k x^(k−1) and k (k − 1) x^(k−2) for k < N.
+    let powers = |x: f64| {
+        let mut p = [1.0; N];
+        for k in 1..N {
+            p[k] = p[k - 1] * x;
+        }
+        let mut d = [0.0; N];
+        let mut dd = [0.0; N];
+        for k in 1..N {
+            d[k] = k as f64 * p[k - 1];
+        }
+        for k in 2..N {
+            dd[k] = (k * (k - 1)) as f64 * p[k - 2];
+        }
+        (p, d, dd)
+    };
+    let (pu, du, ddu) = powers(u);
+    let (pv, dv, ddv) = powers(v);
+    let mut e = LimitEval::default();
+    let mut start = 0;
+    for a in 0..N {
+        let len = if TRIANGLE { N - a } else { N };
+        let Some(row) = c.get(start..start + len) else {
+            break;
+        };
+        start += len;
+        let mut s0 = row[0];
+        let mut s1 = Vec3::ZERO;
+        let mut s2 = Vec3::ZERO;
+        for b in 1..len {
+            s0 += row[b] * pv[b];
+            s1 += row[b] * dv[b];
+        }
+        for b in 2..len {
+            s2 += row[b] * ddv[b];
+        }
+        if a == 0 {
+            e.point += s0;
+            e.dv += s1;
+            e.dvv += s2;
+            continue;
+        }
+        e.point += s0 * pu[a];
+        e.dv += s1 * pu[a];
+        e.dvv += s2 * pu[a];
+        e.du += s0 * du[a];
+        e.duv += s1 * du[a];
+        if a >= 2 {
+            e.duu += s0 * ddu[a];
+        }
+    }
+    e
+}
+
 /// x^k and its first two derivatives, for k = 0..=4.
 fn powers(x: f64) -> [[f64; 5]; 3] {
     let p = [1.0, x, x * x, x * x * x, x * x * x * x];
@@ -198,6 +257,19 @@ pub(crate) struct PowerBasis {
     pub points: usize,
     /// `exps.len() × points`, row-major: power coefficients from spline control points.
     pub to_power: Vec<f64>,
+    /// The monomial set, for the unrolled evaluation.
+    layout: Layout,
+}
+
+/// The monomial sets of the three schemes, in the order of [`PowerBasis::exps`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Layout {
+    /// u^a v^b with a + b ≤ 4 (Loop's box spline).
+    Triangle4,
+    /// u^a v^b with a, b ≤ 3 (bicubic).
+    Square3,
+    /// u^a v^b with a, b ≤ 2 (biquadratic).
+    Square2,
 }
 
 /// Power coefficients of the uniform cubic B-spline basis on [0, 1] (rows: basis functions).
@@ -230,6 +302,7 @@ impl PowerBasis {
                 exps,
                 points: 12,
                 to_power,
+                layout: Layout::Triangle4,
             };
         }
         let n = degree + 1;
@@ -257,6 +330,11 @@ impl PowerBasis {
             exps,
             points: n * n,
             to_power,
+            layout: if degree == 3 {
+                Layout::Square3
+            } else {
+                Layout::Square2
+            },
         }
     }
 
@@ -277,31 +355,15 @@ impl PowerBasis {
     /// Factored as Σ_a u^a (Σ_b c_ab v^b): the inner sums and their first two v-derivatives
     /// take three multiply-adds per monomial, and each power of u then combines them into the
     /// six outputs, instead of six products per monomial (this is the innermost loop of the
-    /// foot-point search).
+    /// foot-point search). Each scheme's monomial set has its own fully unrolled copy, which
+    /// skips the terms that are zero (the derivatives of the low powers).
+    #[inline]
     pub fn eval(&self, coeffs: &[Vec3], u: f64, v: f64) -> LimitEval {
-        let (pu, pv) = (powers(u), powers(v));
-        let mut e = LimitEval::default();
-        let add_row = |e: &mut LimitEval, a: usize, s: [Vec3; 3]| {
-            e.point += s[0] * pu[0][a];
-            e.du += s[0] * pu[1][a];
-            e.duu += s[0] * pu[2][a];
-            e.dv += s[1] * pu[0][a];
-            e.duv += s[1] * pu[1][a];
-            e.dvv += s[2] * pu[0][a];
-        };
-        let mut row = self.exps.first().map_or(0, |&(a, _)| a);
-        let mut s = [Vec3::ZERO; 3];
-        for (&(a, b), &c) in self.exps.iter().zip(coeffs) {
-            if a != row {
-                add_row(&mut e, row, s);
-                (row, s) = (a, [Vec3::ZERO; 3]);
-            }
-            s[0] += c * pv[0][b];
-            s[1] += c * pv[1][b];
-            s[2] += c * pv[2][b];
+        match self.layout {
+            Layout::Triangle4 => eval_power::<5, true>(coeffs, u, v),
+            Layout::Square3 => eval_power::<4, false>(coeffs, u, v),
+            Layout::Square2 => eval_power::<3, false>(coeffs, u, v),
         }
-        add_row(&mut e, row, s);
-        e
     }
 
     /// Values of the monomials at (u, v), into `out` (length [`PowerBasis::len`]).

@@ -156,34 +156,120 @@ pub(crate) struct Graph {
     shortcut_of: HashMap<u32, u32>,
 }
 
-/// The first [`SHORTCUT_DEPTH`] levels of a patch shape's descent, with every regular leaf's
-/// power coefficients and every deeper sub-patch's points written as one dense matrix over the
-/// patch's local points. A surface multiplies these by its control points once per update
-/// ([`Graph::fill_shortcut`]); evaluation then walks a few cells and evaluates one polynomial
-/// instead of subdividing per sample.
+/// The first [`SHORTCUT_DEPTH`] levels of a patch shape's descent, flattened: every regular
+/// leaf's power coefficients and every deeper sub-patch's points written as one dense matrix over
+/// the patch's local points. A surface multiplies these by its control points once per update
+/// ([`Graph::fill_shortcut`]); evaluation then looks the parameter's cell up in a grid and
+/// evaluates one polynomial instead of subdividing per sample.
+///
+/// A leaf's polynomial is rewritten in the patch's own parameters, relative to the leaf's origin
+/// (w = (u, v) − origin), so that it gives the patch's derivatives directly. The child maps of
+/// every scheme are ±2 times a rotation by a multiple of 90° (or the identity), so the rewrite only
+/// permutes coefficients, flips signs and scales them by powers of two: it is exact, and keeps
+/// a tensor-product or total-degree monomial set as it is.
 #[derive(Clone)]
 struct Shortcut {
-    cells: Vec<Cell>,
+    /// The entry of every cell of the [`GRID`] × [`GRID`] grid over the patch domain (two
+    /// triangles per square for Loop: see [`Graph::cell`]).
+    grid: Vec<u16>,
+    entries: Vec<Entry>,
     /// Local points of the root.
     k: usize,
-    /// Length of a patch's cached data (sum of the cells' lengths).
+    /// Length of a patch's cached data (sum of the entries' lengths).
     len: usize,
 }
 
+/// Cells per side of a shortcut's lookup grid: the finest sub-patches of a shortcut.
+const GRID: usize = 1 << SHORTCUT_DEPTH;
+
 #[derive(Clone)]
-enum Cell {
-    /// Descend into the child cell holding the parameter.
-    Split { children: Vec<(u32, ChildMap)> },
-    /// A regular sub-patch: `mat` (monomials × k) gives its power coefficients.
-    Leaf { offset: usize, mat: Vec<f64> },
+enum Entry {
+    /// A regular sub-patch: `mat` (monomials × k) gives its power coefficients in
+    /// w = (u, v) − `origin` (or, with `map`, in the sub-patch's own parameters
+    /// `map.apply(u, v)`, when they could not be rewritten).
+    Leaf {
+        offset: usize,
+        origin: [f64; 2],
+        map: Option<ChildMap>,
+        mat: Vec<f64>,
+    },
     /// A sub-patch at the shortcut's depth that needs more subdivision: `mat` (`kd × k`) gives
-    /// its local points, and [`Graph::eval`] continues from `node`.
+    /// its local points, and [`Graph::eval`] continues from `node` at `map.apply(u, v)`.
     Deep {
         offset: usize,
         node: u32,
         kd: usize,
+        map: ChildMap,
         mat: Vec<f64>,
     },
+}
+
+/// The descent tree of a shortcut while it is built.
+enum Tree {
+    Split(Vec<(usize, ChildMap)>),
+    End(usize),
+}
+
+/// The composite map of descending through `inner` then `outer`: `outer(inner(p))`.
+fn compose(outer: &ChildMap, inner: &ChildMap) -> ChildMap {
+    // outer(inner(p)) = mo (mi (p − oi) − oo) = mo mi (p − oi − mi⁻¹ oo).
+    let mi = inner.m;
+    let det = mi[0][0] * mi[1][1] - mi[0][1] * mi[1][0];
+    let inv = [
+        [mi[1][1] / det, -mi[0][1] / det],
+        [-mi[1][0] / det, mi[0][0] / det],
+    ];
+    let oo = outer.origin;
+    ChildMap {
+        origin: [
+            inner.origin[0] + inv[0][0] * oo[0] + inv[0][1] * oo[1],
+            inner.origin[1] + inv[1][0] * oo[0] + inv[1][1] * oo[1],
+        ],
+        m: mul2(outer.m, mi),
+    }
+}
+
+/// The matrix (`exps.len()`², row-major, new monomial by old) that rewrites power coefficients
+/// in q = m w into coefficients in w, or `None` when the result leaves the monomial set `exps`.
+fn substitution(exps: &[(usize, usize)], m: [[f64; 2]; 2]) -> Option<Vec<f64>> {
+    const N: usize = 9;
+    type Poly = [[f64; N]; N];
+    let times_linear = |p: &Poly, a: f64, b: f64| -> Option<Poly> {
+        // p · (a w₁ + b w₂)
+        let mut out = [[0.0; N]; N];
+        for i in 0..N {
+            for j in 0..N {
+                if p[i][j] == 0.0 {
+                    continue;
+                }
+                if i + 1 >= N || j + 1 >= N {
+                    return None;
+                }
+                out[i + 1][j] += p[i][j] * a;
+                out[i][j + 1] += p[i][j] * b;
+            }
+        }
+        Some(out)
+    };
+    let n = exps.len();
+    let mut t = vec![0.0; n * n];
+    for (col, &(ea, eb)) in exps.iter().enumerate() {
+        let mut p = [[0.0; N]; N];
+        p[0][0] = 1.0;
+        for _ in 0..ea {
+            p = times_linear(&p, m[0][0], m[0][1])?;
+        }
+        for _ in 0..eb {
+            p = times_linear(&p, m[1][0], m[1][1])?;
+        }
+        for (i, row) in p.iter().enumerate() {
+            for (j, &c) in row.iter().enumerate().filter(|(_, &c)| c != 0.0) {
+                let r = exps.iter().position(|&e| e == (i, j))?;
+                t[r * n + col] += c;
+            }
+        }
+    }
+    Some(t)
 }
 
 /// Dense `rows × k` product of a sparse `rows × m` matrix and a dense `m × k` one.
@@ -645,39 +731,109 @@ impl Graph {
         for i in 0..k {
             identity[i * k + i] = 1.0;
         }
-        let mut cells = Vec::new();
-        self.shortcut_cell(node, 0, identity, k, &mut cells);
+        let mut tree = Vec::new();
+        let mut entries = Vec::new();
+        let root_map = ChildMap {
+            origin: [0.0, 0.0],
+            m: [[1.0, 0.0], [0.0, 1.0]],
+        };
+        self.shortcut_cell(node, 0, identity, root_map, k, &mut tree, &mut entries);
         let mut len = 0;
-        for cell in &mut cells {
-            match cell {
-                Cell::Leaf { offset, .. } => {
+        for entry in &mut entries {
+            match entry {
+                Entry::Leaf { offset, .. } => {
                     *offset = len;
                     len += self.power.len();
                 }
-                Cell::Deep { offset, kd, .. } => {
+                Entry::Deep { offset, kd, .. } => {
                     *offset = len;
                     len += *kd;
                 }
-                Cell::Split { .. } => {}
             }
         }
+        let grid = self.cell_centres().map(|(u, v)| {
+            let mut at = 0;
+            let (mut u, mut v) = (u, v);
+            while let Tree::Split(children) = &tree[at] {
+                let ci = if children.len() == 1 {
+                    0
+                } else {
+                    pick_child(self.scheme, u, v)
+                };
+                let Some(&(next, map)) = children.get(ci) else {
+                    break;
+                };
+                (u, v) = map.apply(u, v);
+                at = next;
+            }
+            match tree[at] {
+                Tree::End(e) => e as u16,
+                Tree::Split(_) => 0,
+            }
+        });
         let id = self.shortcuts.len() as u32;
-        self.shortcuts.push(Shortcut { cells, k, len });
+        self.shortcuts.push(Shortcut {
+            grid: grid.collect(),
+            entries,
+            k,
+            len,
+        });
         self.shortcut_of.insert(node, id);
         id
     }
 
-    /// Appends the cell of `node` at `depth`, whose local points are `acc` (`k_node × k`) times
-    /// the root's, and its descendants; returns its index.
+    /// A point inside every cell of a shortcut's grid, in the order of [`Graph::cell`].
+    fn cell_centres(&self) -> impl Iterator<Item = (f64, f64)> {
+        let triangle = self.scheme == Scheme::Loop;
+        let h = 1.0 / GRID as f64;
+        (0..GRID * GRID * if triangle { 2 } else { 1 }).map(move |c| {
+            let (sq, upper) = if triangle {
+                (c / 2, c % 2 == 1)
+            } else {
+                (c, false)
+            };
+            let (i, j) = ((sq % GRID) as f64, (sq / GRID) as f64);
+            match (triangle, upper) {
+                (false, _) => ((i + 0.5) * h, (j + 0.5) * h),
+                (true, false) => ((i + 1.0 / 3.0) * h, (j + 1.0 / 3.0) * h),
+                (true, true) => ((i + 2.0 / 3.0) * h, (j + 2.0 / 3.0) * h),
+            }
+        })
+    }
+
+    /// The grid cell of a shortcut holding (u, v): square (i, j) of the [`GRID`] × [`GRID`]
+    /// grid, each square halved along its anti-diagonal for Loop (lower triangle first).
+    /// Parameters outside the domain go to the nearest cell of the square grid.
+    #[inline]
+    fn cell(&self, u: f64, v: f64) -> usize {
+        let g = GRID as f64;
+        let (x, y) = (u * g, v * g);
+        // `as usize` saturates: negative and NaN give 0.
+        let (i, j) = ((x as usize).min(GRID - 1), (y as usize).min(GRID - 1));
+        let sq = j * GRID + i;
+        if self.scheme == Scheme::Loop {
+            let upper = (x - i as f64) + (y - j as f64) > 1.0;
+            2 * sq + usize::from(upper)
+        } else {
+            sq
+        }
+    }
+
+    /// Appends the tree node of `node` at `depth` to `tree` (its entry to `entries` if it ends
+    /// there), whose local points are `acc` (`k_node × k`) times the root's and whose
+    /// parameters are `map` of the root's, and its descendants; returns its index in `tree`.
+    #[allow(clippy::too_many_arguments)]
     fn shortcut_cell(
         &self,
         node: u32,
         depth: usize,
         acc: Vec<f64>,
+        map: ChildMap,
         k: usize,
-        cells: &mut Vec<Cell>,
-    ) -> u32 {
-        let id = cells.len() as u32;
+        tree: &mut Vec<Tree>,
+        entries: &mut Vec<Entry>,
+    ) -> usize {
+        let id = tree.len();
         match &self.nodes[node as usize] {
             Node::Regular { gather, .. } => {
                 let cp = sparse_times_dense(gather, &acc, k);
@@ -690,109 +846,152 @@ impl Graph {
                         }
                     }
                 }
-                cells.push(Cell::Leaf { offset: 0, mat });
+                let entry = match substitution(&self.power.exps, map.m) {
+                    Some(t) => {
+                        let n = self.power.len();
+                        let mut rewritten = vec![0.0; n * k];
+                        for r in 0..n {
+                            for c in (0..n).filter(|&c| t[r * n + c] != 0.0) {
+                                let (dst, src) = (r * k, c * k);
+                                for j in 0..k {
+                                    rewritten[dst + j] += t[r * n + c] * mat[src + j];
+                                }
+                            }
+                        }
+                        Entry::Leaf {
+                            offset: 0,
+                            origin: map.origin,
+                            map: None,
+                            mat: rewritten,
+                        }
+                    }
+                    None => Entry::Leaf {
+                        offset: 0,
+                        origin: map.origin,
+                        map: Some(map),
+                        mat,
+                    },
+                };
+                entries.push(entry);
+                tree.push(Tree::End(entries.len() - 1));
             }
             Node::Split { children, .. } if depth < SHORTCUT_DEPTH => {
-                cells.push(Cell::Split {
-                    children: Vec::new(),
-                });
+                tree.push(Tree::Split(Vec::new()));
                 let mut links = Vec::with_capacity(children.len());
                 for ch in children {
                     let next = sparse_times_dense(&ch.mat, &acc, k);
-                    links.push((
-                        self.shortcut_cell(ch.node, depth + 1, next, k, cells),
-                        ch.map,
-                    ));
+                    let inner = compose(&ch.map, &map);
+                    let at = self.shortcut_cell(ch.node, depth + 1, next, inner, k, tree, entries);
+                    links.push((at, ch.map));
                 }
-                cells[id as usize] = Cell::Split { children: links };
+                tree[id] = Tree::Split(links);
             }
-            _ => cells.push(Cell::Deep {
-                offset: 0,
-                node,
-                kd: acc.len() / k.max(1),
-                mat: acc,
-            }),
+            _ => {
+                entries.push(Entry::Deep {
+                    offset: 0,
+                    node,
+                    kd: acc.len() / k.max(1),
+                    map,
+                    mat: acc,
+                });
+                tree.push(Tree::End(entries.len() - 1));
+            }
         }
         id
     }
 
     /// Appends a patch's cached data for shortcut `id` given its local points `pts`.
     pub fn fill_shortcut(&self, id: u32, pts: &[Point3], out: &mut Vec<Vec3>) {
-        for cell in &self.shortcuts[id as usize].cells {
-            match cell {
-                Cell::Leaf { mat, .. } | Cell::Deep { mat, .. } => apply_dense(mat, pts, out),
-                Cell::Split { .. } => {}
+        for entry in &self.shortcuts[id as usize].entries {
+            match entry {
+                Entry::Leaf { mat, .. } | Entry::Deep { mat, .. } => apply_dense(mat, pts, out),
             }
         }
     }
 
-    /// The cell holding (u, v) of shortcut `id`, with the parameters there and the Jacobian of
-    /// those with respect to the patch's.
-    fn walk(&self, id: u32, u: f64, v: f64) -> (&Cell, f64, f64, [[f64; 2]; 2]) {
-        let cells = &self.shortcuts[id as usize].cells;
-        let (mut u, mut v, mut g) = (u, v, [[1.0, 0.0], [0.0, 1.0]]);
-        let mut cell = &cells[0];
-        while let Cell::Split { children } = cell {
-            let ci = if children.len() == 1 {
-                0
-            } else {
-                pick_child(self.scheme, u, v)
-            };
-            let Some(&(next, map)) = children.get(ci) else {
-                break;
-            };
-            (u, v) = map.apply(u, v);
-            g = mul2(map.m, g);
-            cell = &cells[next as usize];
-        }
-        (cell, u, v, g)
+    /// The entry of shortcut `id` whose sub-patch holds (u, v).
+    #[inline]
+    fn entry(&self, id: u32, u: f64, v: f64) -> Option<&Entry> {
+        let sc = self.shortcuts.get(id as usize)?;
+        let e = *sc.grid.get(self.cell(u, v))?;
+        sc.entries.get(e as usize)
     }
 
     /// Limit point and derivatives at (u, v) of a patch with shortcut `id` and cached data
     /// `cache` (from [`Graph::fill_shortcut`]).
+    #[inline]
     pub fn eval_shortcut(&self, id: u32, cache: &[Vec3], u: f64, v: f64) -> LimitEval {
-        let (cell, u, v, g) = self.walk(id, u, v);
-        let mut out = match *cell {
-            Cell::Leaf { offset, .. } => {
-                self.power
-                    .eval(&cache[offset..offset + self.power.len()], u, v)
+        match self.entry(id, u, v) {
+            Some(Entry::Leaf {
+                offset,
+                origin,
+                map: None,
+                ..
+            }) => self.power.eval(
+                &cache[*offset..*offset + self.power.len()],
+                u - origin[0],
+                v - origin[1],
+            ),
+            Some(Entry::Leaf {
+                offset,
+                map: Some(map),
+                ..
+            }) => {
+                let (lu, lv) = map.apply(u, v);
+                let mut out = self
+                    .power
+                    .eval(&cache[*offset..*offset + self.power.len()], lu, lv);
+                chain(&mut out, map.m);
+                out
             }
-            Cell::Deep {
-                offset, node, kd, ..
-            } => self.eval(node, &cache[offset..offset + kd], u, v),
-            Cell::Split { .. } => LimitEval::default(),
-        };
-        chain(&mut out, g);
-        out
+            Some(Entry::Deep {
+                offset,
+                node,
+                kd,
+                map,
+                ..
+            }) => {
+                let (lu, lv) = map.apply(u, v);
+                let mut out = self.eval(*node, &cache[*offset..*offset + kd], lu, lv);
+                chain(&mut out, map.m);
+                out
+            }
+            None => LimitEval::default(),
+        }
     }
 
     /// Weights of the patch's local points for the limit position at (u, v), through the
     /// shortcut `id`.
     pub fn stencil_shortcut(&self, id: u32, u: f64, v: f64, out: &mut Vec<f64>) {
-        let k = self.shortcuts[id as usize].k;
+        let k = self.shortcuts.get(id as usize).map_or(0, |s| s.k);
         out.clear();
         out.resize(k, 0.0);
-        let (cell, u, v, _) = self.walk(id, u, v);
-        match cell {
-            Cell::Leaf { mat, .. } => {
+        let add = |out: &mut Vec<f64>, mat: &[f64], weights: &[f64]| {
+            for (row, &m) in mat.chunks_exact(k.max(1)).zip(weights) {
+                for (o, &w) in out.iter_mut().zip(row) {
+                    *o += m * w;
+                }
+            }
+        };
+        match self.entry(id, u, v) {
+            Some(Entry::Leaf {
+                origin, map, mat, ..
+            }) => {
+                let (lu, lv) = match map {
+                    Some(map) => map.apply(u, v),
+                    None => (u - origin[0], v - origin[1]),
+                };
                 let mut vals = [0.0; 16];
-                self.power.values(u, v, &mut vals);
-                for (row, &m) in mat.chunks_exact(k.max(1)).zip(&vals) {
-                    for (o, &w) in out.iter_mut().zip(row) {
-                        *o += m * w;
-                    }
-                }
+                self.power.values(lu, lv, &mut vals);
+                add(out, mat, &vals);
             }
-            Cell::Deep { node, mat, .. } => {
+            Some(Entry::Deep { node, map, mat, .. }) => {
+                let (lu, lv) = map.apply(u, v);
                 let mut deep = Vec::new();
-                self.stencil(*node, u, v, &mut deep);
-                for (row, &m) in mat.chunks_exact(k.max(1)).zip(&deep) {
-                    for (o, &w) in out.iter_mut().zip(row) {
-                        *o += m * w;
-                    }
-                }
+                self.stencil(*node, lu, lv, &mut deep);
+                add(out, mat, &deep);
             }
-            Cell::Split { .. } => {}
+            None => {}
         }
     }
 

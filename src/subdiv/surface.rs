@@ -20,6 +20,10 @@ struct Patch {
     shortcut: u32,
     /// Where the patch's data starts in [`SubdivSurface::cache`].
     cache: u32,
+    /// The patch's shape in the graph (its root node), for the tests that evaluate it
+    /// without the shortcut.
+    #[cfg(test)]
+    node: u32,
 }
 
 /// The limit surface of a Loop or Catmull–Clark control mesh.
@@ -208,6 +212,8 @@ impl SubdivSurface {
                 direct,
                 shortcut,
                 cache: cache_len as u32,
+                #[cfg(test)]
+                node,
             });
             cache_len += graph.cache_len(direct, shortcut);
         }
@@ -479,5 +485,95 @@ pub fn side_param(domain: PatchDomain, k: usize, t: f64) -> (f64, f64) {
         (PatchDomain::Square, 1) => (1.0, t),
         (PatchDomain::Square, 2) => (1.0 - t, 1.0),
         (PatchDomain::Square, _) => (0.0, 1.0 - t),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::PolyMesh;
+
+    fn bunny() -> PolyMesh {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/subdiv/bunny_coarse.obj"
+        );
+        crate::io::read_path(std::path::Path::new(path))
+            .expect("bunny_coarse.obj")
+            .mesh
+    }
+
+    /// The flattened shortcut (a grid lookup and one polynomial in the patch's parameters)
+    /// against the plain descent through the patch graph, at parameters all over every
+    /// patch that is not a plain spline, dyadic cell edges included.
+    #[test]
+    fn shortcut_evaluation_matches_the_descent() {
+        let mesh = bunny();
+        for scheme in [Scheme::Loop, Scheme::CatmullClark, Scheme::DooSabin] {
+            let control = ControlMesh::try_new(&mesh).expect("control mesh");
+            let control = if scheme == Scheme::CatmullClark {
+                super::super::quadrangulate(&control).expect("quads")
+            } else {
+                control
+            };
+            let s = SubdivSurface::try_new(scheme, control).expect("surface");
+            let pts = s.mesh.positions();
+            let mut checked = 0;
+            for (i, p) in s.patches.iter().enumerate().filter(|(_, p)| !p.direct) {
+                let local: Vec<Point3> = s.ctrl[p.start as usize..(p.start + p.len) as usize]
+                    .iter()
+                    .map(|&j| pts[j as usize])
+                    .collect();
+                let params =
+                    (0..=16).flat_map(|a| [a as f64 / 16.0, a as f64 / 16.0 * 0.999 + 3e-4]);
+                let params: Vec<f64> = params.collect();
+                for &u in &params {
+                    for &v in &params {
+                        if scheme == Scheme::Loop && u + v > 1.0 {
+                            continue;
+                        }
+                        let got = s.eval(SurfaceParam {
+                            patch: i as u32,
+                            u,
+                            v,
+                        });
+                        let want = s.graph.eval(p.node, &local, u, v);
+                        let pairs = [
+                            (got.point, want.point, 1e-12),
+                            (got.du, want.du, 1e-10),
+                            (got.dv, want.dv, 1e-10),
+                            (got.duu, want.duu, 1e-8),
+                            (got.duv, want.duv, 1e-8),
+                            (got.dvv, want.dvv, 1e-8),
+                        ];
+                        // At a corner (an extraordinary vertex) the derivatives are singular: only
+                        // the point is defined. On an edge between the shortcut's sub-patches
+                        // (dyadic parameters) the second derivatives may jump (Doo–Sabin is C1,
+                        // and so are the others at boundaries and creases): the lookup and the
+                        // descent may take different sides.
+                        let on = |x: f64| x == 0.0;
+                        let corner = [u, v, 1.0 - u - v, 1.0 - u, 1.0 - v]
+                            .into_iter()
+                            .filter(|&x| on(x))
+                            .count()
+                            >= 2;
+                        let dyadic = |x: f64| (x * 16.0).fract() == 0.0;
+                        let outputs = match (corner, dyadic(u) || dyadic(v)) {
+                            (true, _) => 1,
+                            (false, true) => 3,
+                            (false, false) => pairs.len(),
+                        };
+                        for (k, (g, w, tol)) in pairs.into_iter().take(outputs).enumerate() {
+                            assert!(
+                                (g - w).length() <= tol * (1.0 + w.length()),
+                                "{scheme:?} patch {i} ({u}, {v}) output {k}: {g} vs {w}"
+                            );
+                        }
+                        checked += 1;
+                    }
+                }
+            }
+            assert!(checked > 1000, "{scheme:?}: only {checked} samples");
+        }
     }
 }
