@@ -21,7 +21,7 @@ use web_time::Instant;
 /// Reads an options object (`undefined` or `null`: all defaults) into a [`FitSpec`]. Going
 /// through a JSON value checks the object's own names: serde-wasm-bindgen alone reads only the
 /// fields a struct declares, so a misspelt option would silently be a default.
-fn spec_from_js(options: JsValue) -> Result<FitSpec, JsError> {
+pub(super) fn spec_from_js(options: JsValue) -> Result<FitSpec, JsError> {
     if options.is_undefined() || options.is_null() {
         return Ok(FitSpec::DEFAULT);
     }

@@ -2,10 +2,12 @@
 //! Names are camelCase on the JavaScript side; bulk data crosses as typed arrays; every error
 //! reaches JavaScript as a thrown `Error` carrying the Rust error's message.
 
+mod bench;
 mod fitter;
 mod scan;
 mod viewer;
 
+pub use bench::FootPointBench;
 pub use fitter::{default_spec, exports_for, methods_for, options_for, Fitter, MeshArrays};
 pub use scan::{load_file, LoadedScan};
 pub use viewer::Viewer;
