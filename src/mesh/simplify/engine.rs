@@ -54,11 +54,12 @@ const DROPPED: u32 = u32::MAX;
 /// Vertices are renumbered once fewer than one in this many are left with faces.
 const DENSE_SHARE: usize = 2;
 
-/// Candidates whose waves run together before the next ones' (about a megabyte of mesh data).
-/// On the 4 M-triangle bunny (quiet VM, one thread), blocks of 2 K–16 K candidates took
-/// 3.8–4.0 s, 64 K 4.2–4.45 s, one block (no blocking) 5.2 s; the deviation of the result moves
-/// with the block size as with any change of order (max 0.55–0.86 %, rms 0.104–0.108 %).
-const WAVE_BLOCK: usize = 1 << 14;
+/// Candidates whose waves run together before the next ones' (a few megabytes of mesh data).
+/// On the 4 M-triangle bunny (one thread, the VM's noise ±5 %), blocks of 2 K–64 K candidates
+/// took 4.0–4.5 s, one block (no blocking) 5.2 s; the deviation of the result moves with the
+/// block size as with any change of order (max 0.65–0.86 %, rms 0.103–0.109 %). This size gave
+/// the lowest there and leaves the bunny (whose passes fit in one block) as it was.
+const WAVE_BLOCK: usize = 1 << 16;
 
 /// A collapse of edge `a`–`b` (`a < b`) at its cost; NaN once refused.
 #[derive(Clone, Copy, Debug)]
@@ -716,15 +717,11 @@ impl Engine {
             k += 1;
         }
         let k = k as usize;
-        let mut keep = used.iter();
-        self.pos.retain(|_| *keep.next().unwrap_or(&false));
-        let mut keep = used.iter();
-        self.quadric.retain(|_| *keep.next().unwrap_or(&false));
-        let mut keep = used.iter();
-        self.boundary.retain(|_| *keep.next().unwrap_or(&false));
+        keep_used(&mut self.pos, &used);
+        keep_used(&mut self.quadric, &used);
+        keep_used(&mut self.boundary, &used);
         if !self.crease.is_empty() {
-            let mut keep = used.iter();
-            self.crease.retain(|_| *keep.next().unwrap_or(&false));
+            keep_used(&mut self.crease, &used);
             for list in &mut self.crease {
                 list.iter_mut().for_each(|w| *w = new[*w as usize]);
             }
@@ -797,6 +794,12 @@ fn normal_unit(pos: &[Point3]) -> f64 {
     } else {
         1.0
     }
+}
+
+/// `values` without the entries whose `used` flag is false, in order.
+fn keep_used<T>(values: &mut Vec<T>, used: &[bool]) {
+    let mut flags = used.iter();
+    values.retain(|_| flags.next().copied().unwrap_or(false));
 }
 
 /// A bijection of `u32` that scatters neighbouring indices (the finaliser of MurmurHash3).
