@@ -66,6 +66,14 @@ impl FitLog {
         status
     }
 
+    /// Replaces the surface → data figures of the last record with `back`.
+    pub(crate) fn amend_back(&mut self, back: Option<BackStats>) {
+        if let Some(last) = self.history.last_mut() {
+            last.e_back_max_pct = back.map(|b| b.max_pct);
+            last.e_back_p99_pct = back.map(|b| b.p99_pct);
+        }
+    }
+
     /// Sets the status without an iteration (a fit found converged or stuck before moving).
     pub(crate) fn stop(&mut self, status: FitStatus) -> FitStatus {
         self.status = status;

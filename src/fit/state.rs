@@ -67,13 +67,28 @@ impl FitState {
     /// them with the nearest data point of each (`None` over a hole; empty when no reference
     /// is set).
     pub(crate) fn measure_back(&mut self, samples: &[Point3]) -> Vec<Option<(f64, Point3)>> {
+        let closest = self.closest_data(samples);
+        self.set_back(&closest);
+        closest
+    }
+
+    /// The distance to the data and the nearest data point of each of `samples` (`None` over a
+    /// hole; empty when no reference is set), leaving the statistics alone.
+    pub(crate) fn closest_data(&self, samples: &[Point3]) -> Vec<Option<(f64, Point3)>> {
         let Some(reference) = &self.reference else {
             return Vec::new();
         };
-        let closest: Vec<_> = samples.iter().map(|&p| reference.closest(p)).collect();
+        samples.iter().map(|&p| reference.closest(p)).collect()
+    }
+
+    /// Sets the surface → data statistics to those of `closest` (from
+    /// [`FitState::closest_data`]); none when no reference is set.
+    pub(crate) fn set_back(&mut self, closest: &[Option<(f64, Point3)>]) {
+        if self.reference.is_none() {
+            return;
+        }
         let distances: Vec<Option<f64>> = closest.iter().map(|c| c.map(|(d, _)| d)).collect();
         self.back = Some(BackStats::of(&distances, self.diagonal));
-        closest
     }
 
     /// The distance to the data of every one of `points` (points of the fitted surface, such
@@ -178,6 +193,12 @@ impl FitState {
         } else {
             super::FitStatus::Running
         }
+    }
+
+    /// Writes the current surface → data statistics into the last iteration's record (a
+    /// measure taken after it closed, such as a fit's final dense one).
+    pub(crate) fn amend_back(&mut self) {
+        self.log.amend_back(self.back);
     }
 
     /// Closes the iteration that began at `start` with `control_points` control points.
