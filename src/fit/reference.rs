@@ -44,9 +44,19 @@ impl BackStats {
     /// The statistics of surface → data `distances` (`None`: a sample over a hole), relative
     /// to a bounding-box `diagonal`.
     pub fn of(distances: &[Option<f64>], diagonal: f64) -> BackStats {
-        let mut d: Vec<f64> = distances.iter().flatten().copied().collect();
-        let over_holes = distances.len() - d.len();
-        if d.is_empty() {
+        BackStats::of_mixed(distances, distances.len(), diagonal)
+    }
+
+    /// [`BackStats::of`] where only the first `uniform` of `distances` sample the surface
+    /// evenly and the rest sample parts of it more finely (where it strays): all count for
+    /// the maximum, only the even ones for the percentile, which the fine ones would skew.
+    pub(crate) fn of_mixed(distances: &[Option<f64>], uniform: usize, diagonal: f64) -> BackStats {
+        let (even, fine) = distances.split_at(uniform.min(distances.len()));
+        let mut d: Vec<f64> = even.iter().flatten().copied().collect();
+        let fine: Vec<f64> = fine.iter().flatten().copied().collect();
+        let samples = d.len() + fine.len();
+        let over_holes = distances.len() - samples;
+        if samples == 0 {
             return BackStats {
                 over_holes,
                 ..BackStats::default()
@@ -57,14 +67,17 @@ impl BackStats {
         } else {
             0.0
         };
-        let k = ((d.len() as f64 * 0.99).ceil() as usize).clamp(1, d.len()) - 1;
-        let (_, p99, _) = d.select_nth_unstable_by(k, f64::total_cmp);
-        let p99 = *p99;
-        let max = d.iter().copied().fold(0.0f64, f64::max);
+        let max = d.iter().chain(&fine).copied().fold(0.0f64, f64::max);
+        let p99 = if d.is_empty() {
+            max
+        } else {
+            let k = ((d.len() as f64 * 0.99).ceil() as usize).clamp(1, d.len()) - 1;
+            *d.select_nth_unstable_by(k, f64::total_cmp).1
+        };
         BackStats {
             max_pct: max * pct,
             p99_pct: p99 * pct,
-            samples: d.len(),
+            samples,
             over_holes,
         }
     }
@@ -463,6 +476,23 @@ fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<u8> {
 mod tests {
     use super::*;
     use crate::geom::Vec3;
+
+    #[test]
+    fn fine_samples_count_for_the_maximum_but_not_the_percentile() {
+        // 200 even samples at 1 (one over a hole), then 10 fine ones at 5, one at 9.
+        let mut d = vec![Some(1.0); 200];
+        d[7] = None;
+        d.extend(vec![Some(5.0); 10]);
+        d.push(Some(9.0));
+        let s = BackStats::of_mixed(&d, 200, 100.0);
+        assert_eq!((s.max_pct, s.p99_pct), (9.0, 1.0));
+        assert_eq!((s.samples, s.over_holes), (210, 1));
+        let all = BackStats::of(&d, 100.0);
+        assert_eq!((all.max_pct, all.p99_pct), (9.0, 5.0));
+        // Only fine samples: the percentile is the maximum.
+        let s = BackStats::of_mixed(&d[200..], 0, 100.0);
+        assert_eq!((s.max_pct, s.p99_pct), (9.0, 9.0));
+    }
 
     /// A unit square in z = 0 made of two triangles (open: four boundary edges).
     fn square() -> PolyMesh {

@@ -68,7 +68,7 @@ impl FitState {
     /// is set).
     pub(crate) fn measure_back(&mut self, samples: &[Point3]) -> Vec<Option<(f64, Point3)>> {
         let closest = self.closest_data(samples);
-        self.set_back(&closest);
+        self.set_back(&closest, closest.len());
         closest
     }
 
@@ -82,13 +82,14 @@ impl FitState {
     }
 
     /// Sets the surface → data statistics to those of `closest` (from
-    /// [`FitState::closest_data`]); none when no reference is set.
-    pub(crate) fn set_back(&mut self, closest: &[Option<(f64, Point3)>]) {
+    /// [`FitState::closest_data`]), of which the first `uniform` sample the surface evenly
+    /// ([`BackStats::of_mixed`]); none when no reference is set.
+    pub(crate) fn set_back(&mut self, closest: &[Option<(f64, Point3)>], uniform: usize) {
         if self.reference.is_none() {
             return;
         }
         let distances: Vec<Option<f64>> = closest.iter().map(|c| c.map(|(d, _)| d)).collect();
-        self.back = Some(BackStats::of(&distances, self.diagonal));
+        self.back = Some(BackStats::of_mixed(&distances, uniform, self.diagonal));
     }
 
     /// The distance to the data of every one of `points` (points of the fitted surface, such

@@ -724,10 +724,24 @@ impl<S: ControlSurface> SubdivFitter<S> {
         if !self.state.has_reference() {
             return;
         }
+        // The even samples first (they alone make the percentile), then the finer ones.
         let mut params = Vec::new();
         for patch in 0..self.surface.num_patches() as u32 {
-            let dense = dense || self.dense_patches.contains(&patch);
             self.back_params(patch, dense, &mut params);
+        }
+        let uniform = params.len();
+        if !dense {
+            let n = self.surface.num_patches() as u32;
+            let mut sticky: Vec<u32> = self
+                .dense_patches
+                .iter()
+                .copied()
+                .filter(|&p| p < n)
+                .collect();
+            sticky.sort_unstable();
+            for patch in sticky {
+                self.cell_centres(patch, DENSE_CELLS, &mut params);
+            }
         }
         let mut closest = self.closest_at(&params);
         let limit = self.max_tolerance().unwrap_or(f64::INFINITY);
@@ -748,7 +762,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
             params.extend(fine);
             self.dense_patches.extend(beyond(&params, &closest, limit));
         }
-        self.state.set_back(&closest);
+        self.state.set_back(&closest, uniform);
         // Pull (the CG moves take the rows) only once the data → surface errors meet E_max:
         // before, refinement and the data shape the surface, and a pull against the data's own
         // (a sharp rim) costs E_max.
