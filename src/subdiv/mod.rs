@@ -24,7 +24,7 @@ mod walk;
 pub use nearest::newton_foot;
 pub use refine::{limit_positions, quadrangulate, refine, refine_levels};
 pub use surface::{side_param, SubdivSurface};
-pub use tessellate::{tessellate, Tessellation};
+pub use tessellate::{grid_params, tessellate, Tessellation};
 
 /// Why a subdivision surface could not be built or refined.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

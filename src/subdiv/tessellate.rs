@@ -18,20 +18,42 @@ pub struct Tessellation {
     pub params: Vec<SurfaceParam>,
 }
 
+/// Appends the parameters [`tessellate`] samples on `patch` with `segments` intervals per
+/// patch edge (at least 1), in its order: (i / n, j / n) for rows i and, within a row, j, with
+/// i + j ≤ n on triangles.
+pub fn grid_params(domain: PatchDomain, patch: u32, segments: usize, out: &mut Vec<SurfaceParam>) {
+    let r = segments.max(1);
+    let h = 1.0 / r as f64;
+    for i in 0..=r {
+        let row = match domain {
+            PatchDomain::Square => r,
+            PatchDomain::Triangle => r - i,
+        };
+        for j in 0..=row {
+            out.push(SurfaceParam {
+                patch,
+                u: i as f64 * h,
+                v: j as f64 * h,
+            });
+        }
+    }
+}
+
 /// Samples every patch of `surface` with `segments` intervals per patch edge (at least 1):
 /// an (n + 1)² grid on square patches, the (n + 1)(n + 2)/2 lattice on triangles.
 pub fn tessellate<S: LimitSurface + ?Sized>(surface: &S, segments: usize) -> Tessellation {
     let r = segments.max(1);
     let mut t = Tessellation::default();
+    let mut params = Vec::new();
     for patch in 0..surface.num_patches() as u32 {
         let base = t.positions.len() as u32;
+        params.clear();
+        grid_params(surface.domain(), patch, r, &mut params);
+        for &at in &params {
+            t.push(surface, at);
+        }
         match surface.domain() {
             PatchDomain::Square => {
-                for i in 0..=r {
-                    for j in 0..=r {
-                        t.push(surface, patch, i, j, r);
-                    }
-                }
                 let id = |i: usize, j: usize| base + (i * (r + 1) + j) as u32;
                 for i in 0..r {
                     for j in 0..r {
@@ -41,12 +63,12 @@ pub fn tessellate<S: LimitSurface + ?Sized>(surface: &S, segments: usize) -> Tes
                 }
             }
             PatchDomain::Triangle => {
+                // Row i (of r + 1 − i samples) starts after the rows before it.
                 let mut row_start = Vec::with_capacity(r + 1);
+                let mut k = 0;
                 for i in 0..=r {
-                    row_start.push(t.positions.len() as u32 - base);
-                    for j in 0..=r - i {
-                        t.push(surface, patch, i, j, r);
-                    }
+                    row_start.push(k);
+                    k += (r + 1 - i) as u32;
                 }
                 let id = |i: usize, j: usize| base + row_start[i] + j as u32;
                 for i in 0..r {
@@ -65,14 +87,8 @@ pub fn tessellate<S: LimitSurface + ?Sized>(surface: &S, segments: usize) -> Tes
 }
 
 impl Tessellation {
-    /// Appends the sample at grid point `(i, j)` of `patch` with `r` intervals per edge.
-    fn push<S: LimitSurface + ?Sized>(&mut self, s: &S, patch: u32, i: usize, j: usize, r: usize) {
-        let h = 1.0 / r as f64;
-        let at = SurfaceParam {
-            patch,
-            u: i as f64 * h,
-            v: j as f64 * h,
-        };
+    /// Appends the sample at `at`.
+    fn push<S: LimitSurface + ?Sized>(&mut self, s: &S, at: SurfaceParam) {
         let e = s.eval(at);
         let finite = e.point.is_finite();
         self.positions

@@ -23,7 +23,9 @@ use super::{
 };
 use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
-use crate::subdiv::{tessellate, LimitSurface, PatchDomain, SubdivError, SurfaceParam};
+use crate::subdiv::{
+    grid_params, tessellate, LimitSurface, PatchDomain, SubdivError, SurfaceParam,
+};
 use frozen::{Fairness, PointFrame, Stencils};
 use index::SurfaceIndex;
 use std::collections::HashSet;
@@ -67,7 +69,7 @@ const DENSE_CELLS: u32 = 4;
 /// on a lattice of this many segments per patch edge (the vertices of a 16-segment display
 /// tessellation): the distance to a scan changes fast near its outline and its holes, faster
 /// than cell centres a quarter of a patch apart follow.
-const SUSPECT_LATTICE: u32 = 16;
+const SUSPECT_LATTICE: usize = 16;
 
 /// A data point's foot point on the limit surface.
 type FootPoint = Nearest<SurfaceParam>;
@@ -693,18 +695,6 @@ impl<S: ControlSurface> SubdivFitter<S> {
         }
     }
 
-    /// The vertices of a lattice of `n` segments per edge of `patch`.
-    fn lattice(&self, patch: u32, n: u32, out: &mut Vec<SurfaceParam>) {
-        let h = 1.0 / f64::from(n);
-        let triangle = self.surface.domain() == PatchDomain::Triangle;
-        for i in 0..=n {
-            for j in (0..=n).filter(|&j| !triangle || i + j <= n) {
-                let (u, v) = (f64::from(i) * h, f64::from(j) * h);
-                out.push(SurfaceParam { patch, u, v });
-            }
-        }
-    }
-
     /// The distance to the data of the surface at `params`, with the nearest data point.
     fn closest_at(&self, params: &[SurfaceParam]) -> Vec<Option<(f64, Point3)>> {
         let samples: Vec<Point3> = params
@@ -756,7 +746,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
             suspects.sort_unstable();
             let mut fine = Vec::new();
             for patch in suspects {
-                self.lattice(patch, SUSPECT_LATTICE, &mut fine);
+                grid_params(self.surface.domain(), patch, SUSPECT_LATTICE, &mut fine);
             }
             closest.extend(self.closest_at(&fine));
             params.extend(fine);
