@@ -154,11 +154,23 @@ impl FitState {
     /// Whether the statistics meet every tolerance, and no surface sample lies farther from the
     /// data than [`BACK_TOLERANCE_FACTOR`] E_max tolerances.
     pub(crate) fn met(&self) -> bool {
-        let back_ok = match (self.back, self.tolerances.max_pct) {
+        self.tolerances.met_by(&self.stats) && self.back_met()
+    }
+
+    /// Whether no measured surface sample lies farther from the data than the bound
+    /// ([`FitState::back_bound`]); true while nothing is measured.
+    pub(crate) fn back_met(&self) -> bool {
+        match (self.back, self.tolerances.max_pct) {
             (Some(b), Some(tol)) => b.max_pct <= BACK_TOLERANCE_FACTOR * tol,
             _ => true,
-        };
-        self.tolerances.met_by(&self.stats) && back_ok
+        }
+    }
+
+    /// The largest surface → data distance a converged fit may have, model units:
+    /// [`BACK_TOLERANCE_FACTOR`] E_max tolerances (`None` without an E_max tolerance).
+    pub(crate) fn back_bound(&self) -> Option<f64> {
+        let tol = self.tolerances.max_pct?;
+        Some(BACK_TOLERANCE_FACTOR * tol / 100.0 * self.diagonal)
     }
 
     /// The data points and the errors to overwrite, at once; call

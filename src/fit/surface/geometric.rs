@@ -225,8 +225,15 @@ impl Fitter for GeometricSurfaceFitter {
             && failing_share(&errors) > self.opts.early_split_share;
         let due = stalled || split_early || self.iters_at_knots >= self.opts.iterations_per_knots;
         let mut refined = false;
-        let status = if errors.iter().all(|e| e.pass) {
-            FitStatus::Converged
+        let all_pass = errors.iter().all(|e| e.pass);
+        let status = if all_pass {
+            // Nothing in the error-vector moves holds a patch that strays from the data
+            // (the least-squares fit stiffens it): such a fit has stalled.
+            if self.fit.measure_strays().is_empty() {
+                FitStatus::Converged
+            } else {
+                FitStatus::Stalled
+            }
         } else if self.log().iterations() + 1 >= self.opts.max_iterations {
             FitStatus::MaxIterations
         } else if !due {
@@ -254,7 +261,9 @@ impl Fitter for GeometricSurfaceFitter {
                 FitStatus::MaxIterations
             }
         };
-        self.fit.measure_back(status);
+        if !all_pass {
+            self.fit.measure_back(status);
+        }
         let n = self.fit.surface.control_points().len();
         Ok(self.fit.state.record(start, n, refined, status))
     }

@@ -203,8 +203,14 @@ impl SurfaceFit {
     /// the fit has stopped (`status` not running).
     pub(crate) fn measure_back(&mut self, status: super::FitStatus) {
         if status != super::FitStatus::Running {
-            measure_back(&mut self.state, &self.surface, &self.uv);
+            self.measure_strays();
         }
+    }
+
+    /// See [`measure_back`]: the current surface against the data, into the state, now;
+    /// returns where it strays beyond the bound.
+    pub(crate) fn measure_strays(&mut self) -> Vec<[f64; 2]> {
+        measure_back(&mut self.state, &self.surface, &self.uv)
     }
 
     /// The points that take part in the fit, with their parameters.
@@ -449,9 +455,16 @@ fn cells_inside(region: &TrimRegion, us: &[f64], vs: &[f64]) -> Vec<bool> {
 /// nearest-triangle query per node, about four nodes per span, and the trim, 25 ms for 40K
 /// points) costs as much as an iteration (bun000 at E_max 0.05 %: 1.0 s more over 9
 /// iterations), and nothing in a B-spline fit acts on it.
-pub(crate) fn measure_back(state: &mut FitState, s: &BSplineSurface, uv: &[[f64; 2]]) {
+///
+/// Returns the parameters of the nodes farther from the data than the bound
+/// ([`FitState::back_bound`]): where the fit strays.
+pub(crate) fn measure_back(
+    state: &mut FitState,
+    s: &BSplineSurface,
+    uv: &[[f64; 2]],
+) -> Vec<[f64; 2]> {
     if !state.has_reference() {
-        return;
+        return Vec::new();
     }
     let (us, vs) = (span_samples(s.knots_u(), 2), span_samples(s.knots_v(), 2));
     let nv = vs.len();
@@ -474,13 +487,20 @@ pub(crate) fn measure_back(state: &mut FitState, s: &BSplineSurface, uv: &[[f64;
             }
         }
     }
-    let samples: Vec<Point3> = marked
+    let at: Vec<[f64; 2]> = marked
         .iter()
         .enumerate()
         .filter(|x| *x.1)
-        .map(|(k, _)| s.eval(us[k / vs.len()], vs[k % vs.len()]))
+        .map(|(k, _)| [us[k / nv], vs[k % nv]])
         .collect();
-    state.measure_back(&samples);
+    let samples: Vec<Point3> = at.iter().map(|&[u, v]| s.eval(u, v)).collect();
+    let closest = state.measure_back(&samples);
+    let bound = state.back_bound().unwrap_or(f64::INFINITY);
+    at.into_iter()
+        .zip(closest)
+        .filter(|(_, c)| c.is_some_and(|(d, _)| d > bound))
+        .map(|(t, _)| t)
+        .collect()
 }
 
 /// The cell of `t` between consecutive `samples` (sorted, at least two).

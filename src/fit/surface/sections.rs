@@ -537,6 +537,9 @@ impl Fitter for SectionsFitter {
             }
             Stage::Columns | Stage::Done => {
                 self.fit_columns()?;
+                // Measured before judging: a surface that strays from the data has not
+                // converged, whatever its data errors (SPEC §6).
+                super::measure_back(&mut self.state, &self.surface, &self.uv);
                 let tol = self.options.tol_pct / 100.0 * self.state.diagonal();
                 if self.state.met() {
                     FitStatus::Converged
@@ -550,9 +553,6 @@ impl Fitter for SectionsFitter {
         };
         if status != FitStatus::Running {
             self.stage = Stage::Done;
-        }
-        if status != FitStatus::Running {
-            super::measure_back(&mut self.state, &self.surface, &self.uv);
         }
         let n = self.surface.control_points().len();
         Ok(self.state.record(start, n, true, status))
