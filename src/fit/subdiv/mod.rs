@@ -138,6 +138,12 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// Whether the last refinement that was due added nothing (the budget left is smaller
     /// than any split, or nothing was worth splitting).
     refine_exhausted: bool,
+    /// Whether the last refinement that was due added less than [`MIN_GROWTH`] of the control
+    /// points: such refinements do not change the fit's course, so they do not keep the stall
+    /// rule from stopping it. Refining by a handful of points every other iteration had kept
+    /// fandisk (with creases, at E_avg 0.01 % / E_max 0.05 %) running for 160 iterations
+    /// with nothing changing.
+    refine_futile: bool,
     /// The fairness weight of every control point's umbrella in the next move, relative to
     /// the median data support (see [`SubdivFitter::adapt_fairness`]).
     fairness: Vec<f64>,
@@ -209,6 +215,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
             since_refine: 0,
             since_growth: 0,
             refine_exhausted: false,
+            refine_futile: false,
             fairness: Vec::new(),
             global_fairness: 0.0,
             local_fairness: Vec::new(),
@@ -898,11 +905,11 @@ impl<S: ControlSurface> SubdivFitter<S> {
             && !self.refine_exhausted
     }
 
-    /// Whether the fit cannot refine any more and its errors stopped falling (see
-    /// [`stalled`]).
+    /// Whether the fit cannot refine any more, or its refinements add too little to matter,
+    /// and its errors stopped falling (see [`stalled`]).
     fn is_stalled(&self) -> bool {
         let history = self.state.log().history();
-        !self.can_refine()
+        (!self.can_refine() || self.refine_futile)
             && self.since_growth >= STALL_WINDOW
             && stalled(
                 history,
@@ -946,11 +953,13 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         if !met && self.due_for_refinement(improvement) {
             refined = self.refine()?;
             self.refine_exhausted = !refined;
+            let grew = self.num_control_points() as f64 >= before_count as f64 * (1.0 + MIN_GROWTH);
+            self.refine_futile = !grew;
+            if grew {
+                self.since_growth = 0;
+            }
             if refined {
                 self.since_refine = 0;
-                if self.num_control_points() as f64 >= before_count as f64 * (1.0 + MIN_GROWTH) {
-                    self.since_growth = 0;
-                }
                 self.dense_patches.clear();
                 self.measure_back();
                 met = self.passes_dense_check();
