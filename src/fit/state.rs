@@ -63,15 +63,6 @@ impl FitState {
         self.reference.is_some()
     }
 
-    /// Measures the surface → data distances of `samples` of the current surface and returns
-    /// them with the nearest data point of each (`None` over a hole; empty when no reference
-    /// is set).
-    pub(crate) fn measure_back(&mut self, samples: &[Point3]) -> Vec<Option<(f64, Point3)>> {
-        let closest = self.closest_data(samples);
-        self.set_back(&closest, closest.len());
-        closest
-    }
-
     /// The distance to the data and the nearest data point of each of `samples` (`None` over a
     /// hole; empty when no reference is set), leaving the statistics alone.
     pub(crate) fn closest_data(&self, samples: &[Point3]) -> Vec<Option<(f64, Point3)>> {
