@@ -491,8 +491,9 @@ pub(crate) fn measure_back(
         }
     }
     // The knots and span midpoints (every other node) first, then the nodes between them
-    // around every one that comes within half the bound: a bulge between knots is measured
-    // where it could matter, and a surface well on its data costs a quarter of the nodes.
+    // around every one that comes within half the bound or is left out: a bulge between knots
+    // is measured where it could matter, and a surface well on its data costs a quarter of
+    // the nodes.
     let bound = state.back_bound().unwrap_or(f64::INFINITY);
     let coarse = |k: usize| (k / nv) % 2 == 0 && (k % nv) % 2 == 0;
     let node = |k: usize| [us[k / nv], vs[k % nv]];
@@ -510,7 +511,9 @@ pub(crate) fn measure_back(
     let mut closest = state.closest_data(&eval(&at));
     let mut suspect = vec![false; marked.len()];
     for (&k, c) in at.iter().zip(&closest) {
-        if c.is_some_and(|(d, _)| d > 0.5 * bound) {
+        // Beside a node left out (over a hole, past the outline) the nodes between can be
+        // over data and far from it.
+        if c.is_none_or(|(d, _)| d > 0.5 * bound) {
             let (i, j) = (k / nv, k % nv);
             for a in i.saturating_sub(1)..=(i + 1).min(us.len() - 1) {
                 for b in j.saturating_sub(1)..=(j + 1).min(nv - 1) {
