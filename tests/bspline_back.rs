@@ -105,5 +105,8 @@ fn the_reported_distance_is_that_of_the_delivered_surface() {
         report.status
     );
     assert!(back > bound, "beetle's single sheet strays: {back} %");
-    assert!(back >= 0.8 * worst, "reported {back} %, tessellation {worst} %");
+    assert!(
+        back >= 0.8 * worst,
+        "reported {back} %, tessellation {worst} %"
+    );
 }
