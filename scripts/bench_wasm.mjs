@@ -2,7 +2,7 @@
 // chromium must take at most 2x the native time). Fits the whole Stanford bunny with Loop,
 // 612 initial control points, E_avg 0.01 %, E_max 0.05 %, at most 7049 control points: in the
 // browser through the `Fitter` API of pkg/ (main thread, one thread), then natively with
-// `target/release/geofit fit` and the same options. Prints a Markdown table.
+// `target/release/geofit fit`, the same options and one thread. Prints a Markdown table.
 //
 // Then the foot-point rate (issue 17, item 2) in the browser: for Loop, Catmull–Clark and
 // Doo–Sabin, the same fit to its end, then every data point's foot point on the final surface,
@@ -132,12 +132,16 @@ function nativeFit(path) {
   const dir = mkdtempSync(join(tmpdir(), 'geofit-bench-'));
   try {
     const json = join(dir, 'report.json');
-    execFileSync(exe, ['fit', path, ...CLI_ARGS, '--json', json], { stdio: 'ignore' });
+    // One thread, as the browser has: the CLI would otherwise find its foot points on all cores.
+    execFileSync(exe, ['fit', path, ...CLI_ARGS, '--json', json], {
+      stdio: 'ignore',
+      env: { ...process.env, GEOFIT_THREADS: '1' },
+    });
     const r = JSON.parse(readFileSync(json, 'utf8'));
     return {
       iterations: r.iterations,
       controlPoints: r.final_control_points,
-      status: r.converged ? 'converged' : 'not converged',
+      status: r.status,
       eAvg: r.e_avg_pct,
       eMax: r.e_max_pct,
       eRms: r.e_rms_pct,
