@@ -3,7 +3,7 @@
 
 use geofit::fit::{
     detect_rows, FitData, FitError, FitSpec, FitStatus, Fitter, Method, Scheme, SectionsFitter,
-    SectionsOptions,
+    SectionsOptions, TolMode,
 };
 use geofit::geom::{Point3, Vec3};
 use geofit::mesh::PolyMesh;
@@ -60,7 +60,10 @@ fn bottle_meets_threshold_and_keeps_the_shoulder() {
     let pts = bottle();
     let diag = geofit::geom::Aabb::from_points(&pts).unwrap().diagonal();
     let tol_pct = 0.1 / diag * 100.0; // 0.1 mm
-    let opts = SectionsOptions::DEFAULT.with_tol_pct(tol_pct);
+                                      // The paper's threshold bounds every point: noise-free sections are judged exactly.
+    let opts = SectionsOptions::DEFAULT
+        .with_tol_pct(tol_pct)
+        .with_tol_mode(TolMode::Exact);
     let mut fit = SectionsFitter::try_new(&pts, rows_of(51, 51), opts).unwrap();
     let first = fit.sigma_features();
     assert_eq!(fit.run().unwrap(), FitStatus::Converged);
@@ -86,17 +89,44 @@ fn bottle_meets_threshold_and_keeps_the_shoulder() {
     assert!(turn >= 0.8 * data_angle, "turn {:.1}°", turn.to_degrees());
 }
 
+/// The range scan: noisy (depths quantised to 0.095 % of the diagonal, rows staggered by half
+/// a pixel), with depth jumps at the ears' and the head's outlines. The fit must not chase the
+/// noise (the union of every row's knots gave 383,541 control points for 20,160 points, an
+/// interpolating surface 2.1 % away from the data), and it meets the tolerance at nearly
+/// every point of the largest rectangle without a jump.
 #[test]
 fn bunny_range_grid_fits() {
     let file = geofit::io::read_path(std::path::Path::new("../shared/data/bun000.ply")).unwrap();
-    assert!(file.range_grid.is_some());
+    let grid = file.range_grid.as_ref().unwrap();
+    let positions = file.mesh.positions();
+    let (indices, rows) = geofit::fit::grid_rows(grid, positions);
+    let spacing = grid.spacing(positions).unwrap();
+    for r in rows.windows(2) {
+        for (&a, &b) in indices[r[0].clone()].iter().zip(&indices[r[1].clone()]) {
+            let step = positions[a as usize].distance(positions[b as usize]);
+            assert!(
+                step <= geofit::fit::JUMP_FACTOR * spacing,
+                "a jump inside the rows"
+            );
+        }
+    }
     let spec = FitSpec::new(Scheme::BsplineSurface).with_method(Some(Method::Sections));
     let mut fit = spec.build(&FitData::from(&file)).unwrap();
     let status = fit.run().unwrap();
     assert_ne!(status, FitStatus::Running);
     let details = fit.details();
-    assert!(details["rows"].as_u64().unwrap() >= 8);
-    assert!(fit.stats().e_max_pct.is_finite());
+    assert_eq!(details["rows"].as_u64().unwrap() as usize, rows.len());
+    let points = fit.point_errors().len();
+    assert_eq!(points, indices.len());
+    assert!(fit.num_control_points() < points / 2, "{details:?}");
+    let tol = 0.1 / 100.0 * fit.state().diagonal();
+    let within = fit.point_errors().iter().filter(|e| e.abs() <= tol).count();
+    assert!(
+        within as f64 >= 0.95 * points as f64,
+        "{within} of {points}"
+    );
+    let back = fit.state().back().unwrap().max_pct;
+    assert!(back < 1.0, "E_back {back} %");
     assert!(details["sigma_pct"].as_f64().unwrap() < 0.1, "{details:?}");
 }
 
@@ -108,14 +138,15 @@ fn rows_from_jumps_and_from_count_through_the_spec() {
     for rows in [None, Some(21)] {
         let mut spec = FitSpec::new(Scheme::BsplineSurface).with_method(Some(Method::Sections));
         spec.rows = rows;
+        spec.tol_mode = TolMode::Exact;
         let mut fit = spec.build(&FitData::points(&mesh)).unwrap();
-        // The skinned surface holds the points (E_max 6e-5 %), but its status is the
-        // surface → data gate's: bare points are measured against their own discs, which
-        // tilt across the roof's crease, so the exact surface measures 0.31 % there (bound
-        // 0.2 %) and stalls. The rows are what this test is about.
+        // The skinned surface holds the points within the tolerance (E_max 0.053 % of
+        // 0.1 %), but its status is the surface → data gate's: bare points are measured
+        // against their own discs, which tilt across the roof's crease, so the surface
+        // measures beyond the bound there and stalls. The rows are what this test is about.
         let status = fit.run().unwrap();
         assert_ne!(status, FitStatus::Running);
-        assert!(fit.stats().e_max_pct < 1e-3, "{:?}", fit.stats());
+        assert!(fit.stats().e_max_pct <= 0.1, "{:?}", fit.stats());
         assert_eq!(fit.details()["rows"], 21);
     }
 }

@@ -6,7 +6,7 @@
 
 mod bottle;
 
-use geofit::fit::{FitData, FitSpec, Fitter, Method, Scheme};
+use geofit::fit::{FitData, FitSpec, Fitter, Method, Scheme, TolMode};
 use geofit::mesh::PolyMesh;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -18,9 +18,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .unwrap_or(1.0);
     let tol_pct = 0.1 / diag * 100.0;
     let mm = |pct: f64| pct / 100.0 * diag;
-    let spec = FitSpec::new(Scheme::BsplineSurface)
+    // The paper's threshold bounds every point: noise-free sections are judged exactly.
+    let mut spec = FitSpec::new(Scheme::BsplineSurface)
         .with_method(Some(Method::Sections))
         .with_tol_max(Some(tol_pct));
+    spec.tol_mode = TolMode::Exact;
     let mut fit = spec.build(&data)?;
     let d0 = fit.details();
     let status = fit.run()?;
@@ -62,6 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .with_tol_max(Some(tol_pct))
             .with_refine(false);
         spec.grid = Some([nu, nv]);
+        spec.tol_mode = TolMode::Exact;
         let mut other = spec.build(&data)?;
         let status = other.run()?;
         let e = other.point_errors();

@@ -54,7 +54,7 @@ pub use surface::{
     detect_rows, energies, grid_rows, parameterize, parameterize_on_surface, CreaseKnot,
     CreaseKnots, FoldPolicy, GeometricSurfaceFitter, GeometricSurfaceOptions, LsqSurfaceFitter,
     LsqSurfaceOptions, ParamOptions, Parameterization, SectionsFitter, SectionsOptions,
-    SurfaceGrid, SurfaceTrim, TolMode,
+    SurfaceGrid, SurfaceTrim, TolMode, JUMP_FACTOR,
 };
 
 use crate::geom::Point3;

@@ -447,7 +447,7 @@ pub const OPTION_TABLE: &[OptionInfo] = &[
         "tolMode",
         "tol-mode",
         &[BS],
-        &[GEO, LSQ],
+        &[GEO, LSQ, SECTIONS],
         "how patches are judged"
     ),
     info!("beta2", "beta2", &[BS], &[LSQ], "thin-plate weight β2"),
@@ -788,7 +788,7 @@ impl FitSpec {
             (Scheme::BsplineSurface, Method::Sections) => {
                 let (points, rows) = match data.grid {
                     Some(grid) => {
-                        let (indices, rows) = grid_rows(grid);
+                        let (indices, rows) = grid_rows(grid, points);
                         let pick = indices.iter().filter_map(|&i| points.get(i as usize));
                         (pick.copied().collect(), rows)
                     }
@@ -1028,6 +1028,7 @@ impl FitSpec {
         SectionsOptions {
             degree: self.degree.unwrap_or(d.degree),
             tol_pct: self.tolerances().max_pct.unwrap_or(d.tol_pct),
+            tol_mode: self.tol_mode,
             rows: self.rows,
             corner_angle_deg: self.corner_angle.unwrap_or(d.corner_angle_deg),
             curvature_jump: self.curvature_jump.unwrap_or(d.curvature_jump),

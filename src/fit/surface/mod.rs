@@ -103,7 +103,7 @@ pub use parameterize::{
     parameterize, parameterize_on_surface, FoldPolicy, ParamOptions, Parameterization,
 };
 pub use patches::TolMode;
-pub use sections::{detect_rows, grid_rows, SectionsFitter, SectionsOptions};
+pub use sections::{detect_rows, grid_rows, SectionsFitter, SectionsOptions, JUMP_FACTOR};
 pub(crate) use trim::outline_on;
 pub use trim::SurfaceTrim;
 

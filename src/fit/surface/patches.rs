@@ -99,10 +99,11 @@ pub(crate) struct Criterion {
     pub(crate) min_sample: usize,
 }
 
-/// Per-patch sums of the distances: count, points within TOL, sum, sum of squares, max.
+/// Sums of the distances of a set of points (a patch, a knot span of a family of sections):
+/// count, points within TOL, sum, sum of squares, max.
 #[derive(Clone, Copy, Debug, Default)]
-struct Acc {
-    count: usize,
+pub(crate) struct Acc {
+    pub(crate) count: usize,
     inliers: usize,
     sum: f64,
     sum_sq: f64,
@@ -110,6 +111,16 @@ struct Acc {
 }
 
 impl Acc {
+    /// Counts one point at distance `d` (either sign) from the fit, against `tol`.
+    pub(crate) fn push(&mut self, d: f64, tol: f64) {
+        let d = d.abs();
+        self.count += 1;
+        self.inliers += usize::from(d <= tol);
+        self.sum += d;
+        self.sum_sq += d * d;
+        self.max = self.max.max(d);
+    }
+
     fn add(&mut self, o: &Acc) {
         self.count += o.count;
         self.inliers += o.inliers;
@@ -119,7 +130,7 @@ impl Acc {
     }
 
     /// (pass, ERR) of these points under `mode`.
-    fn judge(&self, tol: f64, mode: TolMode) -> (bool, f64) {
+    pub(crate) fn judge(&self, tol: f64, mode: TolMode) -> (bool, f64) {
         let n = self.count as f64;
         match mode {
             TolMode::Exact => (self.max <= tol, self.max),
@@ -152,13 +163,7 @@ pub(crate) fn patch_errors(
 ) -> Vec<PatchError> {
     let mut acc = vec![Acc::default(); grid.len()];
     for ((&[u, v], &d), _) in uv.iter().zip(dist).zip(active).filter(|(_, &a)| a) {
-        let a = &mut acc[grid.patch(surface, u, v)];
-        let d = d.abs();
-        a.count += 1;
-        a.inliers += usize::from(d <= crit.tol);
-        a.sum += d;
-        a.sum_sq += d * d;
-        a.max = a.max.max(d);
+        acc[grid.patch(surface, u, v)].push(d, crit.tol);
     }
     let (nu, nv) = (grid.u.len(), grid.v.len());
     (0..acc.len())
