@@ -560,6 +560,30 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     });
   });
 
+  test('a range scan fits as a family of sections: its knots follow the shape, not the noise', async () => {
+    // bun000.ply read in the page with its range grid; the skinned surface of the largest
+    // rectangle without depth jumps (13,875 points). The union of every row's knots had made
+    // 383,541 control points, an interpolating surface 2.1 % away from the data
+    // (docs/sections.md); at the noise floor a few patches stall it.
+    await onFreshPage('sections', async (fresh) => {
+      const file = join(ROOT, '..', 'shared', 'data', 'bun000.ply');
+      await fresh.setInputFiles('#file', { name: 'bun000.ply', mimeType: 'application/octet-stream', buffer: readFileSync(file) });
+      await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+      await fresh.selectOption('#fit-scheme', 'bspline-surface');
+      await fresh.waitForSelector('body[data-fit="paused"]', { timeout: TIMEOUT_MS });
+      await fresh.selectOption('#fit-method', 'sections');
+      await fresh.waitForFunction(() => document.body.dataset.fit === 'paused' && document.querySelector('#fit-method').value === 'sections', null, { timeout: TIMEOUT_MS });
+      const stats = await playToEnd(fresh);
+      console.log(`[e2e] ${backend.name} bun000 sections: ${JSON.stringify(stats)}`);
+      assert.equal(stats.method, 'sections');
+      assert.ok(['converged', 'stalled'].includes(stats.status), stats.status);
+      assert.ok(stats.controlPoints > 100 && stats.controlPoints < 13875 / 2, JSON.stringify(stats));
+      assert.ok(stats.eAvgPct < 0.1, JSON.stringify(stats));
+      assert.ok(Number.isFinite(stats.eBackMaxPct) && stats.eBackMaxPct < 1, JSON.stringify(stats));
+      assert.match(await fresh.textContent('#fit-eback'), /%/);
+    });
+  });
+
   test('a CAD part keeps its sharp creases: tagged on the cage, drawn, exported as USD', async () => {
     await onFreshPage('creases', async (fresh) => {
       const data = join(ROOT, '..', 'shared', 'data');
