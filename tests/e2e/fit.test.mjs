@@ -569,10 +569,10 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       const file = join(ROOT, '..', 'shared', 'data', 'bun000.ply');
       await fresh.setInputFiles('#file', { name: 'bun000.ply', mimeType: 'application/octet-stream', buffer: readFileSync(file) });
       await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+      // No fit is built yet (idle): the choices apply to the one Play builds.
       await fresh.selectOption('#fit-scheme', 'bspline-surface');
-      await fresh.waitForSelector('body[data-fit="paused"]', { timeout: TIMEOUT_MS });
       await fresh.selectOption('#fit-method', 'sections');
-      await fresh.waitForFunction(() => document.body.dataset.fit === 'paused' && document.querySelector('#fit-method').value === 'sections', null, { timeout: TIMEOUT_MS });
+      await fresh.waitForFunction(() => document.body.dataset.fit === 'idle' && document.querySelector('#fit-method').value === 'sections', null, { timeout: TIMEOUT_MS });
       const stats = await playToEnd(fresh);
       console.log(`[e2e] ${backend.name} bun000 sections: ${JSON.stringify(stats)}`);
       assert.equal(stats.method, 'sections');
