@@ -95,12 +95,12 @@ impl GridFeatures {
     pub(super) fn of(
         points: &[Point3],
         rows: &[std::ops::Range<usize>],
+        normals: &[Vec3],
         options: &SectionsOptions,
         tol: f64,
     ) -> Result<(GridFeatures, Vec<f64>), FitError> {
         let (nr, nc) = (rows.len(), rows[0].len());
         let at = |r: usize, c: usize| points[rows[r].start + c];
-        let normals = grid_normals(nr, nc, at);
         let normal = |r: usize, c: usize| normals[r * nc + c];
         let mut params = Vec::with_capacity(points.len());
         let mut row_features = Vec::with_capacity(nr);

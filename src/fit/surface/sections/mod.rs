@@ -149,7 +149,7 @@ pub struct SectionsFitter {
     options: SectionsOptions,
     /// The data rows, as index ranges into the state's data.
     rows: Vec<std::ops::Range<usize>>,
-    /// The multiple knots of the rows and columns that their neighbours confirm.
+    /// The crease lines across and along the rows.
     features: GridFeatures,
     /// The grid's unit normal at every data point ([`grid_normals`]), in data order.
     normals: Vec<Vec3>,
@@ -183,9 +183,9 @@ impl SectionsFitter {
         check_rows(&rows, options.degree)?;
         let diagonal = crate::geom::Aabb::from_points(points).map_or(0.0, |b| b.diagonal());
         let tol = options.tol_pct / 100.0 * diagonal;
-        let (features, row_params) = GridFeatures::of(points, &rows, &options, tol)?;
-        let u_knots = features.u_knots();
         let normals = grid_normals(rows.len(), rows[0].len(), |r, c| points[rows[r].start + c]);
+        let (features, row_params) = GridFeatures::of(points, &rows, &normals, &options, tol)?;
+        let u_knots = features.u_knots();
         let family = Family {
             points,
             sections: &rows,
@@ -245,6 +245,16 @@ impl SectionsFitter {
         self.sigma_features
     }
 
+    /// The data as a family of sections: the rows, their parameters and normals.
+    fn data(&self) -> Family<'_> {
+        Family {
+            points: self.state.data(),
+            sections: &self.rows,
+            params: &self.row_params,
+            normals: &self.normals,
+        }
+    }
+
     /// Foot points from the current parameters, the errors and their statistics.
     fn measure(&mut self) {
         let (points, errors) = self.state.data_and_errors_mut();
@@ -255,12 +265,7 @@ impl SectionsFitter {
     /// Stage 1: single knots placed for all rows at once, to the tolerance.
     fn fit_rows(&mut self) -> Result<(), FitError> {
         let tol = self.options.tol_pct / 100.0 * self.state.diagonal();
-        let family = Family {
-            points: self.state.data(),
-            sections: &self.rows,
-            params: &self.row_params,
-            normals: &self.normals,
-        };
+        let family = self.data();
         let mut knots = self.features.u_knots();
         knots.extend(self.u_splits.iter().map(|&u| (u, 1)));
         let mode = self.options.tol_mode;
@@ -294,12 +299,7 @@ impl SectionsFitter {
     /// whether any was.
     fn split_u(&mut self) -> bool {
         let tol = self.options.tol_pct / 100.0 * self.state.diagonal();
-        let data = Family {
-            points: self.state.data(),
-            sections: &self.rows,
-            params: &self.row_params,
-            normals: &self.normals,
-        };
+        let data = self.data();
         let v: Vec<f64> = self.rows.iter().map(|r| self.uv[r.start][1]).collect();
         let mut halves: Vec<f64> = failing_patches(&self.surface, &data, &v, &self.options, tol)
             .into_iter()
@@ -316,12 +316,7 @@ impl SectionsFitter {
     /// Stage 2: the columns, and the surface they make.
     fn fit_columns(&mut self) -> Result<(), FitError> {
         let tol = self.options.tol_pct / 100.0 * self.state.diagonal();
-        let data = Family {
-            points: self.state.data(),
-            sections: &self.rows,
-            params: &self.row_params,
-            normals: &self.normals,
-        };
+        let data = self.data();
         let (surface, v) = skin(&self.row_curves, &self.features, &self.options, &data, tol)?;
         self.surface = surface;
         self.uv = initial_uv(&self.rows, &self.row_params, &v);
