@@ -11,6 +11,7 @@
 //   paused    a fit exists and does not iterate
 //   running   the worker iterates slice by slice
 //   converged, max_iterations, stalled   the fit stopped (Reset rebuilds it)
+//   cancelled the fit was stopped by Cancel (the worker replaced); like idle
 //   error     the fit could not be built
 import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
@@ -44,7 +45,7 @@ const STATUS_TEXT = {
   building: 'building the control net…', paused: 'paused', running: 'fitting…',
   converged: 'converged: tolerances met', max_iterations: 'stopped: iteration cap reached',
   stalled: 'stalled: the errors stopped falling and the control budget is spent',
-  error: 'error', idle: 'press Play or Step to fit',
+  error: 'error', idle: 'press Play or Step to fit', cancelled: 'cancelled: press Play or Step to fit again',
 };
 
 const el = (id) => /** @type {HTMLElement} */ (document.getElementById(id));
@@ -92,7 +93,7 @@ class FitPanel {
       tolAvgUnits: /** @type {HTMLInputElement} */ (el('fit-tol-avg-units')),
       tolMaxUnits: /** @type {HTMLInputElement} */ (el('fit-tol-max-units')),
       refine: /** @type {HTMLInputElement} */ (el('fit-refine')), maxControl: /** @type {HTMLInputElement} */ (el('fit-max-control')),
-      play: el('fit-play'), step: el('fit-step'), reset: el('fit-reset'),
+      play: el('fit-play'), step: el('fit-step'), reset: el('fit-reset'), cancel: el('fit-cancel'),
       vectors: /** @type {HTMLInputElement} */ (el('show-vectors')), cage: /** @type {HTMLInputElement} */ (el('show-cage')),
       backColors: /** @type {HTMLInputElement} */ (el('show-back')), backLegend: el('back-legend'), backLegendTol: el('back-legend-tol'),
       iso: /** @type {HTMLInputElement} */ (el('show-iso')), untrimmed: /** @type {HTMLInputElement} */ (el('show-untrimmed')), initialMesh: /** @type {HTMLInputElement} */ (el('show-initial')),
@@ -107,7 +108,7 @@ class FitPanel {
       pickLabel: el('pick-label'),
     };
     this.form = new FitForm(this.ui.form);
-    this.worker = new Worker(new URL('./fit-worker.js', import.meta.url), { type: 'module' });
+    this.worker = this.startWorker();
     /** The loaded scan: bytes, name, diagonal. */
     this.scan = null;
     this.state = 'idle';
@@ -150,6 +151,31 @@ class FitPanel {
     this.ui.status.textContent = STATUS_TEXT[state] ?? state;
     this.ui.play.textContent = state === 'running' ? 'Pause' : 'Play';
     this.ui.play.setAttribute('aria-pressed', String(state === 'running'));
+    this.ui.cancel.hidden = state !== 'building' && state !== 'running';
+  }
+
+  /** A fitting worker, its messages routed to this panel. */
+  startWorker() {
+    const worker = new Worker(new URL('./fit-worker.js', import.meta.url), { type: 'module' });
+    worker.onmessage = ({ data }) => this.received(data);
+    worker.onerror = (e) => {
+      this.host.showError(`The fitting worker failed: ${e.message}`);
+      this.go('error');
+    };
+    return worker;
+  }
+
+  /**
+   * Stops the fit at once, whatever the worker is doing: the worker is replaced, since a
+   * set-up (reading, repair, reconstruction, QEM of a big scan) runs inside one call that
+   * cannot be interrupted. The scan stays loaded; Play or Step builds the fit again.
+   */
+  cancel() {
+    this.worker.terminate();
+    this.worker = this.startWorker();
+    if (this.ui.backColors.checked) this.backColorsChanged();
+    this.clear();
+    this.go('cancelled');
   }
 
   /** Asks the worker for a new fit of the current scan with the form's options (iteration 0). */
@@ -454,12 +480,8 @@ class FitPanel {
 
   bind() {
     const u = this.ui;
-    this.worker.onmessage = ({ data }) => this.received(data);
-    this.worker.onerror = (e) => {
-      this.host.showError(`The fitting worker failed: ${e.message}`);
-      this.go('error');
-    };
     u.play.addEventListener('click', () => this.play());
+    u.cancel.addEventListener('click', () => this.cancel());
     u.devCsv.addEventListener('click', () => this.downloadCsv());
     u.step.addEventListener('click', () => this.step());
     u.reset.addEventListener('click', () => this.restart());

@@ -584,6 +584,44 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     });
   });
 
+  test('a 500K-point scan: Cancel stops its set-up at once and the page fits again', async () => {
+    // A wavy open sheet of 500,000 bare points (the set-up reconstructs and simplifies them:
+    // seconds of one call into the core that only replacing the worker can stop).
+    const n = 800;
+    const lines = [];
+    for (let i = 0; i < 625; i += 1) {
+      for (let j = 0; j < n; j += 1) {
+        const x = j / n;
+        const y = i / 625;
+        lines.push(`${x.toFixed(5)} ${y.toFixed(5)} ${(0.05 * Math.sin(7 * x) * Math.cos(5 * y)).toFixed(5)}`);
+      }
+    }
+    await onFreshPage('cancel', async (fresh) => {
+      await fresh.setInputFiles('#file', { name: 'sheet.xyz', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n') + '\n') });
+      await fresh.waitForFunction(() => document.getElementById('num-points').textContent === '500,000', null, { timeout: TIMEOUT_MS });
+      await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+      assert.equal(await fresh.isHidden('#fit-cancel'), true);
+      await fresh.click('#fit-play');
+      await fresh.waitForSelector('body[data-fit="running"]', { timeout: TIMEOUT_MS });
+      assert.equal(await fresh.isHidden('#fit-cancel'), false);
+      await fresh.waitForTimeout(500);
+      const [state, ms, framed] = await fresh.evaluate(() => {
+        const framed = window.geofitFit.lastStats !== null;
+        const t0 = performance.now();
+        document.getElementById('fit-cancel').click();
+        return [document.body.dataset.fit, performance.now() - t0, framed];
+      });
+      console.log(`[e2e] ${backend.name} cancel of 500K points (set-up done: ${framed}): ${state} after ${ms.toFixed(1)} ms`);
+      assert.equal(framed, false, 'cancelled during the set-up');
+      assert.equal(state, 'cancelled');
+      assert.ok(ms < 200, `${ms} ms`);
+      assert.equal(await fresh.isHidden('#fit-cancel'), true);
+      await pickSample(fresh, 'bun000-points.xyz', '5,032');
+      const stats = await playToEnd(fresh);
+      assert.equal(stats.status, 'converged', JSON.stringify(stats));
+    });
+  });
+
   test('a CAD part keeps its sharp creases: tagged on the cage, drawn, exported as USD', async () => {
     await onFreshPage('creases', async (fresh) => {
       const data = join(ROOT, '..', 'shared', 'data');
