@@ -79,8 +79,6 @@ fn chains(features: &[Vec<Feature>]) -> Vec<Chain> {
 /// multiple knot significant at the tolerance ([`significant`]).
 #[derive(Clone, Debug)]
 pub(super) struct GridFeatures {
-    /// The surface's degree.
-    degree: usize,
     /// Across the rows, each at one u: the rows' parameters are aligned on it.
     rows: Vec<(f64, Chain)>,
     /// Along the rows; members' indices are rows.
@@ -118,7 +116,6 @@ impl GridFeatures {
             .collect::<Result<Vec<_>, FitError>>()?;
         let row_chains = align(&mut params, nc, chains(&row_features));
         let features = GridFeatures {
-            degree: options.degree,
             rows: row_chains,
             columns: chains(&columns),
         };
@@ -134,18 +131,18 @@ impl GridFeatures {
     }
 
     /// The knots of the creases along the rows, each at the mean of the parameters `v` of
-    /// the rows it meets, of multiplicity at most degree − 1. A row has one v, so a crease
+    /// the rows it meets, of multiplicity at most `degree` − 1. A row has one v, so a crease
     /// slanting across the columns cannot be aligned as the rows' creases are: a knot per row
     /// it meets made bun000's columns C0 every other row (145 control points for 126 rows),
     /// and a C0 knot at its mean v kinked the surface where the crease is not (E_back 3.2 %
     /// against 0.16 % with C1 knots). The curvature jump lets the columns turn sharply
     /// there; the single knots placed to the tolerance follow the rest.
-    pub(super) fn v_knots(&self, v: &[f64]) -> Vec<(f64, usize)> {
+    pub(super) fn v_knots(&self, v: &[f64], degree: usize) -> Vec<(f64, usize)> {
         let mean = |c: &Chain| {
             let sum: f64 = c.members.iter().map(|(_, f)| v[f.index]).sum();
             sum / c.members.len() as f64
         };
-        let smooth = |c: &Chain| c.multiplicity.min(self.degree.saturating_sub(1).max(1));
+        let smooth = |c: &Chain| c.multiplicity.min(degree.saturating_sub(1).max(1));
         self.columns.iter().map(|c| (mean(c), smooth(c))).collect()
     }
 }
@@ -235,7 +232,7 @@ fn section_features(
     options: &SectionsOptions,
     tol: f64,
 ) -> Result<(Vec<f64>, Vec<Feature>), FitError> {
-    let fitter = KnotPlacementFitter::try_new(points, options.curve_options(1.0, 1.0))?;
+    let fitter = KnotPlacementFitter::try_new(points, options.curve_options())?;
     let params = fitter.params();
     let knots = fitter.features().iter();
     let knots = knots.filter(|k| significant(points, params, k.index, normal(k.index), tol));

@@ -92,7 +92,7 @@ impl SectionsOptions {
                 reason: format!("{n} points per row: need at least 2"),
             });
         }
-        self.curve_options(1.0, 1.0).validate()
+        self.curve_options().validate()
     }
 
     /// How a patch is judged against `tol` model units: the options' mode, small patches
@@ -105,12 +105,11 @@ impl SectionsOptions {
         }
     }
 
-    /// The knot-placement options of a section whose own diagonal is `diagonal`, to an E_max
-    /// of `tol` model units.
-    fn curve_options(&self, tol: f64, diagonal: f64) -> KnotPlacementOptions {
+    /// The knot-placement options whose feature test finds a section's multiple knots (its
+    /// tolerances play no part: the knots between them are placed for all sections at once).
+    fn curve_options(&self) -> KnotPlacementOptions {
         KnotPlacementOptions {
             degree: self.degree,
-            tolerances: Tolerances::max_only(tol / diagonal * 100.0),
             corner_angle_deg: self.corner_angle_deg,
             curvature_jump: self.curvature_jump,
             ..KnotPlacementOptions::DEFAULT
@@ -394,7 +393,13 @@ fn skin(
         }
         Ok(spans)
     };
-    let curves = place_common_knots(&family, features.v_knots(&v), options, tol, failing)?;
+    let curves = place_common_knots(
+        &family,
+        features.v_knots(&v, options.degree),
+        options,
+        tol,
+        failing,
+    )?;
     Ok((surface_of(ku, &curves)?, v))
 }
 
@@ -512,9 +517,10 @@ impl Fitter for SectionsFitter {
                 // Measured before judging: a surface that strays from the data has not
                 // converged, whatever its data errors (SPEC §6).
                 super::measure_back(&mut self.state, &self.surface, &self.uv);
-                if self.patches_pass() && self.state.back_met() {
+                let pass = self.patches_pass();
+                if pass && self.state.back_met() {
                     FitStatus::Converged
-                } else if !self.patches_pass() && self.split_u() {
+                } else if !pass && self.split_u() {
                     self.stage = Stage::Rows;
                     FitStatus::Running
                 } else {
