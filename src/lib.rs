@@ -37,6 +37,7 @@
 //! | [`cloud`] | bare point clouds to meshes (range grid, Delaunay, implicit surface) |
 //! | [`export`] | IGES and STEP export of B-spline / NURBS curves and surfaces; what any fit exports |
 //! | [`fem`] | quadrilateral FEM meshes of fitted B-spline and Catmull–Clark surfaces, graded by curvature, with element quality |
+//! | [`progress`] | progress reports of the long calls (reading, repair, reconstruction, QEM, set-up, iterations) to a scoped sink |
 //! | [`render`] | the wgpu viewer (GPU part on `wasm32` only) and its f32 draw buffers |
 //! | `wasm` | JavaScript bindings (`wasm32` only) |
 //!
@@ -53,6 +54,7 @@ pub mod fit;
 pub mod geom;
 pub mod io;
 pub mod mesh;
+pub mod progress;
 pub mod render;
 pub mod spline;
 pub mod subdiv;

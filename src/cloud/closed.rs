@@ -6,6 +6,7 @@
 
 use super::neighbours::Neighbours;
 use crate::geom::{Point3, Vec3};
+use crate::progress::{self, Part};
 use std::collections::HashMap;
 
 /// Grid corner coordinates (integers, in cells from the grid origin).
@@ -55,13 +56,14 @@ const TETS: [[[i32; 3]; 4]; 6] = [
 
 /// Contour of the implicit surface of oriented `points` on a grid of cell size `cell`, over the
 /// cells within `band` cells of a point. Returns vertices and triangles facing outward (along
-/// the normals).
+/// the normals). Reports its progress as `part`.
 pub(super) fn contour(
     points: &[Point3],
     normals: &[Vec3],
     tree: &Neighbours,
     cell: f64,
     band: i32,
+    part: Part,
 ) -> (Vec<Point3>, Vec<[u32; 3]>) {
     let implicit = Implicit {
         points,
@@ -93,7 +95,10 @@ pub(super) fn contour(
     let corner_pos = |k: Key| origin + Vec3::new(k[0] as f64, k[1] as f64, k[2] as f64) * cell;
     let mut values: HashMap<Key, f64> = HashMap::new();
     let mut mesh = Contour::default();
-    for c in &cells {
+    for (i, c) in cells.iter().enumerate() {
+        if i % progress::BATCH == 0 {
+            part.count(i, cells.len());
+        }
         let mut corner = [[0i32; 3]; 8];
         let mut value = [0.0; 8];
         for (i, (ck, cv)) in corner.iter_mut().zip(value.iter_mut()).enumerate() {

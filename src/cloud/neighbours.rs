@@ -1,6 +1,7 @@
 //! k-nearest-neighbour lists over the points (kd-tree), and the local spacing they give.
 
 use crate::geom::Point3;
+use crate::progress::{self, Part};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use std::num::NonZero;
@@ -35,10 +36,15 @@ impl Neighbours {
     }
 
     /// For every point, the mean distance to its `k` nearest other points.
-    pub(super) fn mean_distances(&self, points: &[Point3], k: usize) -> Vec<f64> {
+    /// Reports its progress as `part`.
+    pub(super) fn mean_distances(&self, points: &[Point3], k: usize, part: Part) -> Vec<f64> {
         points
             .iter()
-            .map(|&p| {
+            .enumerate()
+            .map(|(i, &p)| {
+                if i % progress::BATCH == 0 {
+                    part.count(i, points.len());
+                }
                 let near = self.nearest(p, k + 1);
                 let others = near.len().saturating_sub(1).max(1) as f64;
                 near.iter().skip(1).map(|n| n.1.sqrt()).sum::<f64>() / others

@@ -6,6 +6,7 @@ use super::ReconstructError;
 use crate::geom::Frame;
 use crate::geom::Point3;
 use crate::io::RangeGrid;
+use crate::progress::{self, Part};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 /// Triangles of the range grid, checked against the point count.
@@ -26,7 +27,13 @@ pub(super) fn grid_triangles(
 
 /// Delaunay triangles of the inlier points projected onto the plane of `frame` (its two
 /// major axes), wound counter-clockwise seen from the plane's normal (the minor axis).
-pub(super) fn plane_triangles(points: &[Point3], inlier: &[bool], frame: &Frame) -> Vec<[u32; 3]> {
+/// Reports its progress as `part`.
+pub(super) fn plane_triangles(
+    points: &[Point3],
+    inlier: &[bool],
+    frame: &Frame,
+    part: Part,
+) -> Vec<[u32; 3]> {
     let (u, v) = (frame.axes[2], frame.axes[1]);
     // Orient (u, v, normal) right-handed so faces wind counter-clockwise about the normal.
     let v = if u.cross(v).dot(frame.axes[0]) < 0.0 {
@@ -37,6 +44,9 @@ pub(super) fn plane_triangles(points: &[Point3], inlier: &[bool], frame: &Frame)
     let mut dt: DelaunayTriangulation<Point2<f64>> = DelaunayTriangulation::new();
     let mut original: Vec<u32> = Vec::new();
     for (i, &p) in points.iter().enumerate() {
+        if i % progress::BATCH == 0 {
+            part.count(i, points.len());
+        }
         if !inlier[i] {
             continue;
         }

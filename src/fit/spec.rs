@@ -828,6 +828,7 @@ impl FitSpec {
         fitter
             .log_mut()
             .set_strays(without_strays.map(|w| w.strays));
+        crate::progress::report(crate::progress::Phase::Setup, 1.0);
         Ok(fitter)
     }
 

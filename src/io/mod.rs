@@ -170,6 +170,7 @@ pub fn read_bytes(bytes: &[u8], name: Option<&str>) -> Result<LoadedFile, ReadEr
     if bytes.is_empty() {
         return Err(ReadError::Empty);
     }
+    crate::progress::report(crate::progress::Phase::Reading, 0.0);
     let loaded = match detect::detect(bytes, name).ok_or(ReadError::UnknownFormat)? {
         Format::Ply => ply::read(bytes)?,
         Format::Obj => obj::read(bytes)?,
@@ -189,6 +190,7 @@ pub fn read_bytes(bytes: &[u8], name: Option<&str>) -> Result<LoadedFile, ReadEr
             format: loaded.format,
         });
     }
+    crate::progress::report(crate::progress::Phase::Reading, 1.0);
     Ok(loaded)
 }
 

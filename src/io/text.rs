@@ -2,13 +2,23 @@
 //! copying the file into a `String` (files may hold stray non-UTF-8 bytes in comments).
 
 use super::{Format, Location, ReadError};
+use crate::progress::{self, Phase};
 
 /// Lines of `bytes` with their 1-based numbers, without the `\n` or `\r\n` terminator.
+/// Reports the share of `bytes` read as [`Phase::Reading`] progress.
 pub fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
-    bytes.split(|&b| b == b'\n').enumerate().map(|(i, line)| {
-        let line = line.strip_suffix(b"\r").unwrap_or(line);
-        (i + 1, line)
-    })
+    let mut offset = 0;
+    bytes
+        .split(|&b| b == b'\n')
+        .enumerate()
+        .map(move |(i, line)| {
+            offset += line.len() + 1;
+            if i % progress::BATCH == 0 {
+                progress::report_count(Phase::Reading, offset.min(bytes.len()), bytes.len());
+            }
+            let line = line.strip_suffix(b"\r").unwrap_or(line);
+            (i + 1, line)
+        })
 }
 
 /// Whitespace-separated tokens of one line.

@@ -13,6 +13,7 @@ use crate::fit::{
 use crate::geom::Point3;
 use crate::io;
 use crate::mesh::PolyMesh;
+use crate::progress::{self, Phase};
 use crate::render::buffers;
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
@@ -303,17 +304,32 @@ pub struct Fitter {
     unit_to_metres: Option<f64>,
 }
 
+impl Fitter {
+    /// One iteration, its start and end reported as progress (the engines report their own
+    /// steps in between).
+    fn iterate(&mut self) -> Result<(), JsError> {
+        progress::report(Phase::Iteration, 0.0);
+        self.fit.step()?;
+        progress::report(Phase::Iteration, 1.0);
+        Ok(())
+    }
+}
+
 #[wasm_bindgen]
 impl Fitter {
     /// Builds a fitter of `scan`. Throws on a bad option (naming it) or when the scan cannot be
     /// fitted by the scheme (no faces to make a control mesh from, too few points, ...).
+    /// `onProgress(phase, done)`, when given, hears the set-up's phases (`repair`,
+    /// `reconstruction`, `simplification`, `setup`), each from 0 to 1.
     #[wasm_bindgen(constructor)]
     pub fn new(
         scan: &LoadedScan,
         #[wasm_bindgen(unchecked_param_type = "FitSpec | null | undefined")] options: JsValue,
+        #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+        on_progress: Option<js_sys::Function>,
     ) -> Result<Fitter, JsError> {
         let spec = spec_from_js(options)?;
-        let fit = spec.build(&scan.fit_data())?;
+        let fit = super::with_progress(on_progress, || spec.build(&scan.fit_data()))?;
         let initial = MeshArrays::control_of(fit.as_ref());
         Ok(Fitter {
             fit,
@@ -323,23 +339,38 @@ impl Fitter {
     }
 
     /// Runs one iteration (unless the fit has already stopped) and returns the statistics.
+    /// `onProgress(phase, done)`, when given, hears how far the iteration is (phase
+    /// `iteration`).
     #[wasm_bindgen(unchecked_return_type = "FitStats")]
-    pub fn step(&mut self) -> Result<JsValue, JsError> {
-        self.fit.step()?;
+    pub fn step(
+        &mut self,
+        #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+        on_progress: Option<js_sys::Function>,
+    ) -> Result<JsValue, JsError> {
+        super::with_progress(on_progress, || self.iterate())?;
         self.stats()
     }
 
     /// Iterates until the fit stops or `budget_ms` milliseconds are spent (at least one
-    /// iteration while running); returns the statistics.
+    /// iteration while running); returns the statistics. `onProgress` as for `step`, once
+    /// per iteration.
     #[wasm_bindgen(unchecked_return_type = "FitStats")]
-    pub fn run(&mut self, budget_ms: f64) -> Result<JsValue, JsError> {
+    pub fn run(
+        &mut self,
+        budget_ms: f64,
+        #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+        on_progress: Option<js_sys::Function>,
+    ) -> Result<JsValue, JsError> {
         let start = Instant::now();
-        while self.fit.status() == FitStatus::Running {
-            self.fit.step()?;
-            if start.elapsed().as_secs_f64() * 1000.0 >= budget_ms {
-                break;
+        super::with_progress(on_progress, || {
+            while self.fit.status() == FitStatus::Running {
+                self.iterate()?;
+                if start.elapsed().as_secs_f64() * 1000.0 >= budget_ms {
+                    break;
+                }
             }
-        }
+            Ok::<_, JsError>(())
+        })?;
         self.stats()
     }
 

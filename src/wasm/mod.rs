@@ -12,7 +12,22 @@ pub use fitter::{default_spec, exports_for, methods_for, options_for, Fitter, Me
 pub use scan::{load_file, LoadedScan};
 pub use viewer::Viewer;
 
-use wasm_bindgen::prelude::wasm_bindgen;
+use crate::progress;
+use wasm_bindgen::prelude::{wasm_bindgen, JsValue};
+
+/// Runs `f` with the JavaScript callback `on_progress`, when given, called as
+/// `onProgress(phase, done)` (see [`crate::progress`]) while `f` runs. An exception the
+/// callback throws is dropped: a progress display must not abort the work it displays.
+pub(crate) fn with_progress<R>(on_progress: Option<js_sys::Function>, f: impl FnOnce() -> R) -> R {
+    let Some(callback) = on_progress else {
+        return f();
+    };
+    let sink = move |phase: progress::Phase, done: f64| {
+        let phase = JsValue::from_str(phase.name());
+        let _ = callback.call2(&JsValue::NULL, &phase, &JsValue::from_f64(done));
+    };
+    progress::watch(Box::new(sink), f)
+}
 
 /// The TypeScript interfaces of the plain objects the bindings take and give (`FitSpec`,
 /// `FitStats`, `HistoryEntry`, `FitReport`, ...), written once in `types.d.ts` and copied into

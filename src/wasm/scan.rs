@@ -23,9 +23,15 @@ pub struct LoadedScan {
 
 /// Reads a point or mesh file (PLY, OBJ, STL, XYZ/CSV/PTS) from its bytes. `name` is the file
 /// name, a hint for the format. Throws an `Error` saying what is wrong and where.
+/// `onProgress(phase, done)`, when given, hears how far the reading is (phase `reading`).
 #[wasm_bindgen(js_name = loadFile)]
-pub fn load_file(bytes: &[u8], name: &str) -> Result<LoadedScan, JsError> {
-    let file = io::read_bytes(bytes, Some(name))?;
+pub fn load_file(
+    bytes: &[u8],
+    name: &str,
+    #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+    on_progress: Option<js_sys::Function>,
+) -> Result<LoadedScan, JsError> {
+    let file = super::with_progress(on_progress, || io::read_bytes(bytes, Some(name)))?;
     let strays = find_strays(file.mesh.positions());
     let kept = (!strays.is_empty()).then(|| file.mesh.without_vertices(&strays).0);
     Ok(LoadedScan { file, strays, kept })

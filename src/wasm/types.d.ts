@@ -13,6 +13,14 @@ export type Method = 'geometric' | 'least-squares' | 'knots' | 'sections';
 export type FitStatus = 'running' | 'converged' | 'max_iterations' | 'stalled';
 /** The exports of a fit; `exportsFor(scheme)` says which a scheme offers. */
 export type ExportName = 'cage' | 'creases' | 'usda' | 'json' | 'obj' | 'ply' | 'stl' | 'glb' | 'iges' | 'step' | 'msh';
+/** A stage of the work that `loadFile`, `new Fitter`, `step` and `run` report progress of. */
+export type Phase = 'reading' | 'repair' | 'reconstruction' | 'simplification' | 'setup' | 'iteration';
+/**
+ * Hears progress: `done` runs from 0 to 1 within each phase (about a hundred calls per phase
+ * at most). Called synchronously from inside the work: a worker can post it to the page,
+ * which stays free to draw it. An exception it throws is ignored.
+ */
+export type ProgressCallback = (phase: Phase, done: number) => void;
 /** The file formats `loadFile` reads. */
 export type FileFormat =
   | 'ply' | 'obj' | 'stl' | 'xyz' | 'e57' | 'las' | 'laz' | 'pcd' | 'ptx' | 'gltf' | 'glb';

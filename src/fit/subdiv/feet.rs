@@ -6,6 +6,7 @@ use super::index::SurfaceIndex;
 use super::{FootPoint, SubdivFitOptions};
 use crate::fit::{FitData, FitError, FitSpec, FitStatus, Fitter};
 use crate::geom::{ClosestPoint, NewtonOptions, Point3};
+use crate::progress::{self, Part, Phase};
 use crate::subdiv::{LimitSurface, SubdivSurface, SurfaceParam};
 use web_time::Instant;
 
@@ -48,7 +49,7 @@ pub(crate) fn warm_foot<S: ClosestPoint<Param = SurfaceParam>>(
 }
 
 /// Every point's foot point from the spatial index ([`cold_foot`]). `Err(i)` names a point the
-/// index has nothing near.
+/// index has nothing near. Reports its progress as `part`.
 ///
 /// Points are visited in data order: scans list their points in a spatially coherent order, so
 /// consecutive searches mostly share patches. (Visiting them grouped by patch was measured
@@ -59,10 +60,16 @@ pub(crate) fn cold_feet<S: ClosestPoint<Param = SurfaceParam>>(
     index: &SurfaceIndex,
     data: &[Point3],
     opts: &NewtonOptions,
+    part: Part,
 ) -> Result<Vec<FootPoint>, usize> {
     data.iter()
         .enumerate()
-        .map(|(i, &p)| cold_foot(surface, index, p, opts).ok_or(i))
+        .map(|(i, &p)| {
+            if i % progress::BATCH == 0 {
+                part.count(i, data.len());
+            }
+            cold_foot(surface, index, p, opts).ok_or(i)
+        })
         .collect()
 }
 
@@ -80,6 +87,13 @@ pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam>>(
         *o = warm_foot(surface, index, p, prev, opts, slack);
     }
 }
+
+/// The benchmark's searches report as a whole set-up.
+const BENCH_PART: Part = Part {
+    phase: Phase::Setup,
+    from: 0.0,
+    to: 1.0,
+};
 
 /// What one timed pass of [`FootPointBench`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -195,7 +209,7 @@ impl FootPointBench {
             .with_step_tol(options.newton.step_tol * diagonal);
         surface.set_control_points(before);
         let index = SurfaceIndex::build(&surface, resolution);
-        let previous = cold_feet(&surface, &index, &data, &newton)
+        let previous = cold_feet(&surface, &index, &data, &newton, BENCH_PART)
             .map_err(|point| FitError::NoSurfaceNear { point })?;
         surface.set_control_points(&after);
         let index = SurfaceIndex::build(&surface, resolution);
@@ -255,7 +269,13 @@ impl FootPointBench {
     /// One pass of cold foot points: every data point from the spatial index.
     pub fn cold(&self) -> FootPointTiming {
         let start = Instant::now();
-        let feet = cold_feet(&self.surface, &self.index, &self.data, &self.newton);
+        let feet = cold_feet(
+            &self.surface,
+            &self.index,
+            &self.data,
+            &self.newton,
+            BENCH_PART,
+        );
         let seconds = start.elapsed().as_secs_f64();
         summary(feet.as_deref().unwrap_or(&[]), seconds)
     }

@@ -23,6 +23,7 @@ use super::{
 };
 use crate::geom::{ClosestPoint, Nearest, NewtonOptions, Point3, Vec3};
 use crate::mesh::PolyMesh;
+use crate::progress::{self, Part, Phase};
 use crate::subdiv::{
     grid_params, tessellate, LimitSurface, PatchDomain, SubdivError, SurfaceParam,
 };
@@ -35,6 +36,25 @@ use web_time::Instant;
 /// refinement changes the surface little (Loop's and Catmull–Clark's splits not at all away
 /// from the split faces), so such a jump means a broken split, not a worse fit.
 const REFINE_WORSE_FACTOR: f64 = 2.0;
+
+/// The set-up's share for its foot points (the spatial index and patches come before, the
+/// surface → data distances after).
+const SETUP_FEET: Part = Part {
+    phase: Phase::Setup,
+    from: 0.2,
+    to: 0.9,
+};
+
+/// Progress of an iteration: moving the control points (foot points and the solve) takes
+/// most of it, then the surface → data distances and, when due, a refinement, whose new foot
+/// points report in the refinement's share.
+const ITERATION_MOVED: f64 = 0.6;
+const ITERATION_MEASURED: f64 = 0.75;
+const REFINE_FEET: Part = Part {
+    phase: Phase::Iteration,
+    from: 0.8,
+    to: 0.95,
+};
 
 /// A refinement that adds less than this share of the control points (or a budget with less
 /// room than that) no longer changes a fit's course: it does not restart the stall window.
@@ -183,6 +203,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         options: SubdivFitOptions,
     ) -> Result<Self, FitError> {
         let start = Instant::now();
+        progress::report(Phase::Setup, 0.0);
         options.validate()?;
         crate::geom::check_coordinates(data_points)?;
         if data_points.is_empty() {
@@ -229,8 +250,10 @@ impl<S: ControlSurface> SubdivFitter<S> {
             index,
             scratch: Vec::new(),
         };
-        fitter.search_all_feet()?;
+        progress::report(Phase::Setup, SETUP_FEET.from);
+        fitter.search_all_feet(SETUP_FEET)?;
         fitter.measure_back();
+        progress::report(Phase::Setup, 1.0);
         let n = fitter.log().initial_control_points();
         *fitter.state.log_mut() = FitLog::new(n, start);
         Ok(fitter)
@@ -290,9 +313,9 @@ impl<S: ControlSurface> SubdivFitter<S> {
     }
 
     /// Global search: every foot point from the spatial index, then Newton.
-    fn search_all_feet(&mut self) -> Result<(), FitError> {
+    fn search_all_feet(&mut self, part: Part) -> Result<(), FitError> {
         let opts = self.newton;
-        self.feet = feet::cold_feet(&self.surface, &self.index, self.state.data(), &opts)
+        self.feet = feet::cold_feet(&self.surface, &self.index, self.state.data(), &opts, part)
             .map_err(|point| FitError::NoSurfaceNear { point })?;
         self.update_errors();
         Ok(())
@@ -562,7 +585,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                     // to the control mesh before it, and no more refinement.
                     self.surface = previous;
                     self.index = SurfaceIndex::build(&self.surface, self.index_resolution());
-                    self.search_all_feet()?;
+                    self.search_all_feet(REFINE_FEET)?;
                     return Ok(false);
                 }
                 return Ok(true);
@@ -935,9 +958,12 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
             return Ok(self.state.log_mut().stop(FitStatus::Converged));
         }
         let start = Instant::now();
+        progress::report(Phase::Iteration, 0.0);
         let before = self.state.stats().e_rms;
         let moved = self.move_control_points();
+        progress::report(Phase::Iteration, ITERATION_MOVED);
         self.measure_back();
+        progress::report(Phase::Iteration, ITERATION_MEASURED);
         self.adapt_fairness();
         self.adapt_point_weights(moved);
         self.since_refine += 1;
@@ -965,6 +991,7 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
                 met = self.passes_dense_check();
             }
         }
+        progress::report(Phase::Iteration, 1.0);
         let mut status = self.state.status_after(met, self.options.max_iter);
         let n = self.num_control_points();
         self.state.record(start, n, refined, status);

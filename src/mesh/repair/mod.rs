@@ -55,6 +55,7 @@ pub use report::{Components, Found, RepairReport};
 
 use super::{MeshError, PolyMesh};
 use crate::geom::Point3;
+use crate::progress::{self, Phase};
 use orient::Orientation;
 use soup::Soup;
 
@@ -108,7 +109,9 @@ pub fn repair(mesh: &PolyMesh) -> Result<Repaired, MeshError> {
 /// the same mesh gives the same result.
 pub fn repair_with(mesh: &PolyMesh, options: &RepairOptions) -> Result<Repaired, MeshError> {
     let mut report = RepairReport::default();
+    progress::report(Phase::Repair, 0.0);
     let soup = clean::clean(mesh, &mut report);
+    progress::report(Phase::Repair, 0.3);
     let mut work = Work {
         soup,
         positions: mesh.positions().to_vec(),
@@ -116,8 +119,11 @@ pub fn repair_with(mesh: &PolyMesh, options: &RepairOptions) -> Result<Repaired,
         report,
     };
     let orientation = work.make_manifold()?;
+    progress::report(Phase::Repair, 0.8);
     work.leave_tiny_components(&orientation, options.data_only_faces);
-    Ok(work.finish())
+    let repaired = work.finish();
+    progress::report(Phase::Repair, 1.0);
+    Ok(repaired)
 }
 
 /// The state of a repair between its steps.

@@ -63,6 +63,7 @@ pub use error::SimplifyError;
 use crate::geom::Point3;
 use crate::mesh::repair::{repair, RepairReport};
 use crate::mesh::PolyMesh;
+use crate::progress::{self, Phase};
 use check::Limits;
 use engine::Engine;
 use serde::Serialize;
@@ -421,7 +422,14 @@ fn reduce(engine: &mut Engine, target: usize, stages: &[Limits]) -> (usize, Vec<
     let mut stage = 0;
     let mut passes = 0;
     let mut relaxations = Vec::new();
+    let first = engine.live();
+    let progress = |live: usize| {
+        let to_go = first.saturating_sub(target);
+        progress::report_count(Phase::Simplification, first - live.max(target), to_go);
+    };
+    progress(first);
     while engine.live() > target {
+        progress(engine.live());
         passes += 1;
         if engine.pass(target, &stages[stage]) > 0 || engine.scramble_ties() {
             continue;
@@ -436,6 +444,7 @@ fn reduce(engine: &mut Engine, target: usize, stages: &[Limits]) -> (usize, Vec<
             min_triangle_quality: limits.min_quality,
         });
     }
+    progress::report(Phase::Simplification, 1.0);
     (passes, relaxations)
 }
 
