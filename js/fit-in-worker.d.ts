@@ -1,4 +1,4 @@
-import type { ExportName, FitReport, FitSpec, FitStats } from './geofit.js';
+import type { ExportName, FitReport, FitSpec, FitStats, Phase } from './geofit.js';
 
 /** A shape for drawing: `x, y, z` per vertex (f32), smooth normals (empty for a curve), three indices per triangle (empty for a curve), two per polygon edge or curve segment. */
 export interface MeshData {
@@ -31,6 +31,8 @@ export interface FitResult {
 export interface FitInWorkerOptions {
   /** Called with a frame after every slice while the fit runs. */
   onProgress?: (frame: FitFrame) => void;
+  /** Called as the worker reads the file, sets the fit up and iterates: the phase and how far it is (0 to 1), at most one call per 50 ms within a phase (see `ProgressCallback`). */
+  onPhase?: (phase: Phase, done: number) => void;
   /** Aborting it terminates the worker; the promise rejects with `signal.reason` (an `AbortError` `DOMException` unless another reason was given). */
   signal?: AbortSignal;
   /** Milliseconds of fitting between frames (at least one iteration each) [40]. */
@@ -68,5 +70,6 @@ export interface WorkerRequest {
 /** The messages the worker sends back. */
 export type WorkerMessage =
   | FitFrame
+  | { type: 'phase'; phase: Phase; done: number }
   | { type: 'done'; result: FitResult }
   | { type: 'error'; message: string };

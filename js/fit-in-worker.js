@@ -1,11 +1,11 @@
 // `geofit/worker`: a fit off the main thread without writing the worker. Each call starts a module
 // worker (worker.js, found by `new URL(..., import.meta.url)`, which bundlers follow), sends it the
-// file, forwards its frames to `onProgress` and resolves with the result; aborting `signal`
+// file, forwards its frames to `onProgress` and its phases to `onPhase`, and resolves with the result; aborting `signal`
 // terminates the worker at once, even in the middle of an iteration. Types: fit-in-worker.d.ts.
 
 /** @type {import('./fit-in-worker.js').fitInWorker} */
 export function fitInWorker(fileBytes, name, spec = {}, options = {}) {
-  const { onProgress, signal, sliceMs = 40, resolution = 3, exports = [] } = options;
+  const { onProgress, onPhase, signal, sliceMs = 40, resolution = 3, exports = [] } = options;
   return new Promise((resolve, reject) => {
     if (signal?.aborted) {
       reject(signal.reason);
@@ -24,6 +24,10 @@ export function fitInWorker(fileBytes, name, spec = {}, options = {}) {
     worker.onmessage = ({ data }) => {
       if (data.type === 'frame') {
         onProgress?.(data);
+        return;
+      }
+      if (data.type === 'phase') {
+        onPhase?.(data.phase, data.done);
         return;
       }
       finish();

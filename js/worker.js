@@ -40,17 +40,17 @@ function buffers(...meshes) {
  * @param {WorkerRequest} request
  */
 function fit({ bytes, name, spec, sliceMs, resolution, exports }) {
-  const scan = loadFile(bytes, name);
+  const scan = loadFile(bytes, name, phase);
   let fitter;
   try {
-    fitter = new Fitter(scan, spec);
+    fitter = new Fitter(scan, spec, phase);
   } finally {
     scan.free();
   }
   try {
     let stats = fitter.stats();
     while (stats.status === 'running') {
-      stats = fitter.run(sliceMs);
+      stats = fitter.run(sliceMs, phase);
       const limit = meshData(fitter.limitMesh(resolution));
       post({ type: 'frame', stats, limit }, buffers(limit));
     }
@@ -65,6 +65,22 @@ function fit({ bytes, name, spec, sliceMs, resolution, exports }) {
   } finally {
     fitter.free();
   }
+}
+
+/** The last phase posted and when: one message per PHASE_MS within a phase. */
+const PHASE_MS = 50;
+const lastPhase = { phase: '', at: -Infinity };
+
+/**
+ * Posts how far the work is (the core's `onProgress`).
+ * @param {import('./geofit.js').Phase} phase
+ * @param {number} done
+ */
+function phase(phase, done) {
+  const now = performance.now();
+  if (phase === lastPhase.phase && now - lastPhase.at < PHASE_MS && done < 1) return;
+  Object.assign(lastPhase, { phase, at: now });
+  post({ type: 'phase', phase, done });
 }
 
 const ready = init();

@@ -6,28 +6,37 @@
 // shared Viewer and into text, so no main-thread task grows with the fit.
 //
 // The panel is one object, `FitPanel`, in one of these states (shown as `body[data-fit]`):
+//   loading   the worker reads and parses a file (the fit, if any, is paused; a file that cannot
+//             be read leaves it as it was)
 //   idle      a scan is loaded, no fit built (Play, Step and Reset build one)
 //   building  the worker was asked to build a fit; its first frame moves on to paused/running
 //   paused    a fit exists and does not iterate
 //   running   the worker iterates slice by slice
 //   converged, max_iterations, stalled   the fit stopped (Reset rebuilds it)
-//   cancelled the fit was stopped by Cancel (the worker replaced); like idle
+//   cancelled the fit or the file's loading was stopped by Cancel (the worker replaced, the
+//             scan on screen read again in the background); like idle
 //   error     the fit could not be built
 import { MSG } from './protocol.js';
 import { FitForm } from './fit-form.js';
 import {
-  CAGE_COLOR, CHART_CONTEXT, CREASE_COLOR, DATA_CREASE_COLOR, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, deviationCsv, drawChart,
+  CAGE_COLOR, CHART_CONTEXT, CREASE_COLOR, DATA_CREASE_COLOR, CURVE_COLOR, INITIAL_COLOR, ISO_COLOR, VECTOR_COLOR, drawChart,
   distanceColors, drawHistogram, edgeSegments, errorColors, fmtPct, fmtUnits, lineSet,
 } from './fit-view.js';
 
 export { drawChart, errorColors } from './fit-view.js';
+
+// What each phase of the work is called in the progress line.
+const PHASE_TEXT = {
+  reading: 'Reading the file', repair: 'Repairing the mesh', reconstruction: 'Meshing the points',
+  simplification: 'Simplifying (QEM)', setup: 'Setting up the fit',
+};
 
 // Download name and MIME type of each export.
 const DOWNLOADS = {
   cage: ['geofit-cage.obj', 'model/obj'], obj: ['geofit-limit.obj', 'model/obj'],
   creases: ['geofit-cage.creases.json', 'application/json'], usda: ['geofit-cage.usda', 'model/vnd.usda'],
   ply: ['geofit-limit.ply', 'application/octet-stream'], stl: ['geofit-limit.stl', 'model/stl'],
-  glb: ['geofit-surface.glb', 'model/gltf-binary'],
+  glb: ['geofit-surface.glb', 'model/gltf-binary'], csv: ['geofit-deviations.csv', 'text/csv'],
   iges: ['geofit.igs', 'model/iges'], step: ['geofit.stp', 'model/step'],
   msh: ['geofit-fem.msh', 'text/plain'], json: ['geofit-report.json', 'application/json'],
 };
@@ -45,7 +54,7 @@ const STATUS_TEXT = {
   building: 'building the control net…', paused: 'paused', running: 'fitting…',
   converged: 'converged: tolerances met', max_iterations: 'stopped: iteration cap reached',
   stalled: 'stalled: the errors stopped falling and the control budget is spent',
-  error: 'error', idle: 'press Play or Step to fit', cancelled: 'cancelled: press Play or Step to fit again',
+  error: 'error', loading: 'reading the file', idle: 'press Play or Step to fit', cancelled: 'cancelled: press Play or Step to fit again',
 };
 
 const el = (id) => /** @type {HTMLElement} */ (document.getElementById(id));
@@ -106,11 +115,17 @@ class FitPanel {
       devMean: el('dev-mean'), devP50: el('dev-p50'), devP95: el('dev-p95'), devMax: el('dev-max'),
       devWithin: el('dev-within'), devCsv: /** @type {HTMLButtonElement} */ (el('dev-csv')),
       pickLabel: el('pick-label'),
+      progressRow: el('fit-progress-row'), progress: /** @type {HTMLProgressElement} */ (el('fit-progress')), phase: el('fit-phase'),
+      allPoints: /** @type {HTMLInputElement} */ (el('show-all-points')),
     };
     this.form = new FitForm(this.ui.form);
     this.worker = this.startWorker();
-    /** The loaded scan: bytes, name, diagonal. */
+    /** The loaded scan: file (a Blob), name, diagonal. */
     this.scan = null;
+    // The file being read, its request number and the promise's settlers; `seq` numbers the
+    // load requests, so a reply to an older one is dropped.
+    this.loading = null;
+    this.seq = 0;
     this.state = 'idle';
     // generation: the fit the worker was last asked to build; frames of older fits are
     // dropped. built: the generation that has a fit (0: none for this scan).
@@ -129,7 +144,9 @@ class FitPanel {
     // Figures the page and the tests read: the worker's latest statistics and history, frames
     // shown, the longest stage of showing one and the longest of each stage.
     // deviation: the latest frame's distribution of the errors (the package's `Deviation`).
-    this.figures = { lastStats: null, history: [], creaseEdges: 0, deviation: null, surfaceTriangles: 0, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
+    // phases: every progress phase heard since the page opened, in order, with the largest
+    // share reported (the tests read it); drawnPoints: data points drawn.
+    this.figures = { phases: [], drawnPoints: 0, lastStats: null, history: [], creaseEdges: 0, deviation: null, surfaceTriangles: 0, deviationMs: 0, chartMs: 0, frames: 0, maxStageMs: 0, stageMs: [0, 0, 0, 0] };
     this.tolUnits = [
       linkTolerance(this.ui.tolAvg, this.ui.tolAvgUnits, () => this.diagonal(), () => this.form.edited.add('tolAvg')),
       linkTolerance(this.ui.tolMax, this.ui.tolMaxUnits, () => this.diagonal(), () => this.form.edited.add('tolMax')),
@@ -151,7 +168,71 @@ class FitPanel {
     this.ui.status.textContent = STATUS_TEXT[state] ?? state;
     this.ui.play.textContent = state === 'running' ? 'Pause' : 'Play';
     this.ui.play.setAttribute('aria-pressed', String(state === 'running'));
-    this.ui.cancel.hidden = state !== 'building' && state !== 'running';
+    this.ui.cancel.hidden = !['loading', 'building', 'running'].includes(state);
+    if (!['loading', 'building', 'running'].includes(state)) this.ui.progressRow.hidden = true;
+  }
+
+  /**
+   * Shows a phase of the work under way and how far it is.
+   * @param {import('../pkg/geofit.js').Phase} phase
+   * @param {number} done
+   */
+  showProgress(phase, done) {
+    const u = this.ui;
+    if (!['loading', 'building', 'running'].includes(this.state)) return;
+    const iter = (this.figures.lastStats?.iter ?? 0) + 1;
+    const label = phase === 'iteration' ? `Iteration ${iter}` : PHASE_TEXT[phase] ?? phase;
+    u.progress.value = done;
+    u.phase.textContent = `${label}: ${Math.round(100 * done)} %`;
+    u.progressRow.hidden = false;
+    const seen = this.figures.phases;
+    const last = seen[seen.length - 1];
+    if (last?.phase === phase && done >= last.done) last.done = done;
+    else seen.push({ phase, done });
+  }
+
+  /**
+   * Has the worker read and parse `file` (a File or Blob called `name`); resolves with the
+   * worker's `loaded` message once it is the page's scan (`preset`: the fit options of a
+   * bundled sample), rejects with the reader's error (the previous scan and its fit stay) or,
+   * when a newer load or Cancel overtakes it, with `{ superseded: true }`.
+   * @param {Blob} file
+   * @param {string} name
+   * @returns {Promise<import('./protocol.js').LoadedMessage>}
+   */
+  load(file, name, preset = {}) {
+    this.loading?.reject({ superseded: true });
+    if (this.playing) this.worker.postMessage({ type: MSG.pause });
+    this.seq += 1;
+    this.go('loading');
+    this.worker.postMessage({ type: MSG.load, seq: this.seq, file, name });
+    return new Promise((resolve, reject) => {
+      this.loading = { seq: this.seq, file, name, preset, resolve, reject };
+    });
+  }
+
+  /** The state a fit that is not running rests in: from its last frame, else idle. */
+  resting() {
+    if (!this.frame) return 'idle';
+    const status = this.frame.stats.status;
+    return status === 'running' ? 'paused' : status;
+  }
+
+  /** @param {import('./protocol.js').LoadedMessage} m */
+  loaded(m) {
+    this.figures.drawnPoints = m.points.length / 3;
+    if (m.seq === -1) {
+      this.host.showPoints?.(m);
+      return;
+    }
+    const loading = this.loading;
+    if (!loading || m.seq !== loading.seq) return;
+    this.loading = null;
+    this.scan = { file: loading.file, name: loading.name, diagonal: m.diagonal };
+    this.form.apply(loading.preset);
+    for (const update of this.tolUnits) update();
+    this.clear();
+    loading.resolve(m);
   }
 
   /** A fitting worker, its messages routed to this panel. */
@@ -174,8 +255,21 @@ class FitPanel {
     this.worker.terminate();
     this.worker = this.startWorker();
     if (this.ui.backColors.checked) this.backColorsChanged();
+    if (this.ui.allPoints.checked) this.allPointsChanged();
+    this.loading?.reject({ superseded: true });
+    this.loading = null;
+    // The new worker reads the scan on screen again, in the background.
+    if (this.scan) {
+      this.seq += 1;
+      this.worker.postMessage({ type: MSG.load, seq: this.seq, file: this.scan.file, name: this.scan.name, quiet: true });
+    }
     this.clear();
     this.go('cancelled');
+  }
+
+  /** The "all points" toggle: the worker sends every point, or a subsample within its budget. */
+  allPointsChanged() {
+    this.worker.postMessage({ type: MSG.points, all: this.ui.allPoints.checked });
   }
 
   /** Asks the worker for a new fit of the current scan with the form's options (iteration 0). */
@@ -185,8 +279,7 @@ class FitPanel {
     this.generation += 1;
     this.built = this.generation;
     this.go('building');
-    const { bytes, name } = this.scan;
-    this.worker.postMessage({ type: MSG.start, generation: this.generation, bytes: bytes.slice(), name, spec: this.form.spec() });
+    this.worker.postMessage({ type: MSG.start, generation: this.generation, spec: this.form.spec() });
   }
 
   /** Forgets the fit (a new scan was loaded): the page shows the scan until Play, Step or Reset. */
@@ -258,6 +351,7 @@ class FitPanel {
 
   drawPoints(viewer) {
     viewer.setPoints(this.once.data, errorColors(this.frame.errors, this.tolMaxUnits(this.frame.stats)));
+    this.figures.drawnPoints = this.once.data.length / 3;
   }
 
   /**
@@ -354,11 +448,9 @@ class FitPanel {
     drawHistogram(u.histogram, d);
   }
 
-  /** Downloads the per-point deviations of the frame on screen as CSV. */
+  /** Downloads the deviations of every data point (not only the drawn ones) as CSV. */
   downloadCsv() {
-    if (!this.frame || !this.once) return;
-    const text = deviationCsv(this.once.data, this.frame.errors, this.frame.deviation);
-    download(new TextEncoder().encode(text), 'geofit-deviations.csv', 'text/csv');
+    if (this.frame) this.worker.postMessage({ type: MSG.export, what: 'csv' });
   }
 
   /**
@@ -429,7 +521,8 @@ class FitPanel {
       this.host.requestRender();
       this.playing = m.playing;
       const status = m.stats.status;
-      this.go(status === 'running' ? (this.playing ? 'running' : 'paused') : status);
+      // A file being read keeps its state; the frame is the paused fit's.
+      if (this.state !== 'loading') this.go(status === 'running' ? (this.playing ? 'running' : 'paused') : status);
     }
   }
 
@@ -466,9 +559,19 @@ class FitPanel {
         this.showing = true;
         setTimeout(() => this.showNewest(), 0);
       }
+    } else if (m.type === MSG.loaded) {
+      this.loaded(m);
+    } else if (m.type === MSG.progress) {
+      this.showProgress(m.phase, m.done);
     } else if (m.type === MSG.exported) {
       download(m.bytes, ...DOWNLOADS[m.what]);
       if (m.quality) el('fit-fem-quality').textContent = femText(m.quality);
+    } else if (m.type === MSG.error && m.during === MSG.load) {
+      const loading = this.loading;
+      this.loading = null;
+      this.go(this.resting());
+      if (loading) loading.reject(new Error(m.message));
+      else this.host.showError(`Could not read the file again: ${m.message}`);
     } else if (m.type === MSG.error) {
       if (m.generation !== this.generation) return;
       this.host.showError(`Fit (${m.during}): ${m.message}`);
@@ -493,6 +596,7 @@ class FitPanel {
     u.refine.addEventListener('change', () => { u.maxControl.disabled = !u.refine.checked; });
     for (const box of [u.cage, u.vectors, u.iso, u.untrimmed, u.initialMesh]) box.addEventListener('change', () => this.redraw());
     u.backColors.addEventListener('change', () => this.backColorsChanged());
+    u.allPoints.addEventListener('change', () => this.allPointsChanged());
     for (const button of document.querySelectorAll('[data-export]')) {
       const what = /** @type {HTMLElement} */ (button).dataset.export;
       button.addEventListener('click', () => this.worker.postMessage({ type: MSG.export, what }));
@@ -514,23 +618,17 @@ class FitPanel {
     }).observe(u.histogram);
   }
 
-  /** A new scan was loaded: `preset` holds the options that suit a bundled sample. */
-  onScan(bytes, name, diagonal, preset = {}) {
-    this.scan = { bytes, name, diagonal };
-    this.form.apply(preset);
-    for (const update of this.tolUnits) update();
-    this.clear();
-  }
 }
 
 /**
- * Wires the fitting panel. `host` gives the viewer, a render request and the error line.
- * Returns `{ onScan(bytes, name, diagonal, preset), pick(x, y), figures }`.
+ * Wires the fitting panel. `host` gives the viewer, a render request, the error line and
+ * `showPoints(loaded)` (draws a scan's points again after the "all points" toggle).
+ * Returns `{ load(file, name, preset), pick(x, y), figures }`.
  */
 export function createFitUi(host) {
   const panel = new FitPanel(host);
   return {
-    onScan: (bytes, name, diagonal, preset) => panel.onScan(bytes, name, diagonal, preset),
+    load: (file, name, preset) => panel.load(file, name, preset),
     pick: (x, y) => panel.pick(x, y),
     figures: panel.figures,
   };

@@ -1,6 +1,7 @@
-// The geofit demo page: loads a point or mesh file through the Rust readers (wasm) and draws it
-// with the wgpu viewer. The page opens with a bundled sample; a file picker and drag-and-drop load
-// others; a file that cannot be read leaves the previous one on screen and says why.
+// The geofit demo page: loads a point or mesh file through the Rust readers (wasm, in the fitting
+// worker, which reads and parses it once and keeps it for the fits) and draws it with the wgpu
+// viewer. The page opens with a bundled sample; a file picker and drag-and-drop load others; a
+// file that cannot be read leaves the previous one on screen and says why.
 import init, { Viewer, loadFile } from '../pkg/geofit.js';
 import { createFitUi } from './fit-ui.js';
 
@@ -84,51 +85,53 @@ function heightColors(positions) {
   return colors;
 }
 
-/** The bounding-box diagonal of a loaded scan (model units). */
-function diagonal(scan) {
-  const [lo, hi] = [scan.bboxMin(), scan.bboxMax()];
-  return lo.length === 3 ? Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) : 0;
+/**
+ * Draws the points of a loaded scan (the worker's `loaded` message), coloured by height.
+ * @param {import('./protocol.js').LoadedMessage} loaded
+ */
+function showPoints(loaded) {
+  viewer?.setPoints(loaded.points, heightColors(loaded.points));
+  requestRender();
 }
 
 /**
- * Parses `bytes` with the Rust readers and shows the result; on error keeps what was shown.
- * `preset`: the fit options of a bundled sample (a user's file has none: the core's defaults).
+ * Has the worker read `file` (a File or Blob called `name`) and shows the result; on error
+ * keeps what was shown. `preset`: the fit options of a bundled sample (a user's file has none:
+ * the core's defaults). Returns whether the file is now the page's scan.
+ * @param {Blob} file
+ * @param {string} name
  */
-function show(bytes, name, preset = {}) {
-  let scan;
+async function show(file, name, preset = {}) {
+  setState('loading');
+  let loaded;
   try {
-    scan = loadFile(bytes, name);
+    loaded = await fitUi.load(file, name, preset);
   } catch (e) {
+    if (e?.superseded) return false;
     showError(`Could not load ${name}: ${e?.message ?? e}`);
     setState('error');
     return false;
   }
   try {
-    const positions = scan.positions();
-    const indices = scan.indices();
-    const normals = indices.length > 0 ? scan.normals() : new Float32Array();
-    const meshPositions = indices.length > 0 ? positions : new Float32Array();
     if (viewer) {
-      viewer.setPoints(positions, heightColors(positions));
-      viewer.setMesh(meshPositions, normals, indices);
+      showPoints(loaded);
+      const mesh = loaded.mesh ?? { positions: new Float32Array(), normals: new Float32Array(), indices: new Uint32Array() };
+      viewer.setMesh(mesh.positions, mesh.normals, mesh.indices);
       viewer.setLines(new Float32Array(), new Float32Array());
       viewer.fitView();
     }
     ui.fileName.textContent = name;
-    ui.points.textContent = scan.numPoints.toLocaleString('en-US');
-    ui.triangles.textContent = scan.numTriangles.toLocaleString('en-US');
-    showStrays(scan.strays());
+    ui.points.textContent = loaded.numPoints.toLocaleString('en-US');
+    ui.triangles.textContent = loaded.numTriangles.toLocaleString('en-US');
+    showStrays(loaded.strays);
     clearError();
     setState('ready');
     requestRender();
-    fitUi?.onScan(bytes, name, diagonal(scan), preset);
     return true;
   } catch (e) {
     showError(`Could not show ${name}: ${e?.message ?? e}`);
     setState('error');
     return false;
-  } finally {
-    scan.free();
   }
 }
 
@@ -139,9 +142,9 @@ function showStrays(strays) {
   ui.straysRow.hidden = strays.length === 0;
 }
 
-async function openFile(file) {
-  const bytes = new Uint8Array(await file.arrayBuffer());
-  show(bytes, file.name);
+/** Loads a picked or dropped file: the worker reads it (the page never holds its bytes). */
+function openFile(file) {
+  show(file, file.name);
 }
 
 function updateLayers() {
@@ -264,7 +267,7 @@ async function main() {
   await init();
   bindFiles();
   bindCamera();
-  fitUi = createFitUi({ viewer: () => viewer, requestRender, showError, canvas: ui.canvas });
+  fitUi = createFitUi({ viewer: () => viewer, requestRender, showError, showPoints, canvas: ui.canvas });
   // Test hook (read by tests/e2e, not an API): the fitting panel's figures.
   window.geofitFit = fitUi.figures;
   for (const box of [ui.showPoints, ui.showMesh, ui.showWireframe, ui.showZebra]) {
@@ -346,7 +349,7 @@ async function openLink(params) {
     const response = await fetch(url);
     if (!response.ok) throw new Error(`HTTP ${response.status}`);
     const name = decodeURIComponent(url.pathname.split('/').pop() || 'file');
-    if (show(new Uint8Array(await response.arrayBuffer()), name, preset)) return;
+    if (await show(await response.blob(), name, preset)) return;
     problem = ui.error.textContent;
   } catch (e) {
     problem = `Could not open ?src=${src}: ${e?.message ?? e}`;
@@ -372,7 +375,7 @@ async function openSample(name) {
     setState('error');
     return;
   }
-  show(new Uint8Array(await response.arrayBuffer()), name, samplePresets[name]);
+  await show(await response.blob(), name, samplePresets[name]);
 }
 
 main().catch((e) => {

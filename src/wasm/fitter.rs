@@ -325,7 +325,7 @@ impl Fitter {
     pub fn new(
         scan: &LoadedScan,
         #[wasm_bindgen(unchecked_param_type = "FitSpec | null | undefined")] options: JsValue,
-        #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+        #[wasm_bindgen(js_name = onProgress, unchecked_optional_param_type = "ProgressCallback | null")]
         on_progress: Option<js_sys::Function>,
     ) -> Result<Fitter, JsError> {
         let spec = spec_from_js(options)?;
@@ -344,7 +344,7 @@ impl Fitter {
     #[wasm_bindgen(unchecked_return_type = "FitStats")]
     pub fn step(
         &mut self,
-        #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+        #[wasm_bindgen(js_name = onProgress, unchecked_optional_param_type = "ProgressCallback | null")]
         on_progress: Option<js_sys::Function>,
     ) -> Result<JsValue, JsError> {
         super::with_progress(on_progress, || self.iterate())?;
@@ -358,7 +358,7 @@ impl Fitter {
     pub fn run(
         &mut self,
         budget_ms: f64,
-        #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+        #[wasm_bindgen(js_name = onProgress, unchecked_optional_param_type = "ProgressCallback | null")]
         on_progress: Option<js_sys::Function>,
     ) -> Result<JsValue, JsError> {
         let start = Instant::now();

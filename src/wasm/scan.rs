@@ -28,7 +28,7 @@ pub struct LoadedScan {
 pub fn load_file(
     bytes: &[u8],
     name: &str,
-    #[wasm_bindgen(js_name = onProgress, unchecked_param_type = "ProgressCallback | null | undefined")]
+    #[wasm_bindgen(js_name = onProgress, unchecked_optional_param_type = "ProgressCallback | null")]
     on_progress: Option<js_sys::Function>,
 ) -> Result<LoadedScan, JsError> {
     let file = super::with_progress(on_progress, || io::read_bytes(bytes, Some(name)))?;

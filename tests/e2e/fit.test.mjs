@@ -584,27 +584,40 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     });
   });
 
-  test('a 500K-point scan: Cancel stops its set-up at once and the page fits again', async () => {
-    // A wavy open sheet of 500,000 bare points (the set-up reconstructs and simplifies them:
-    // seconds of one call into the core that only replacing the worker can stop).
+  test('a 500K-point scan: read once in the worker, drawn within the point budget, progress shown, Cancel at once, loaded again and fitted', async () => {
+    // A wavy open sheet of 500,000 bare points in rows, jittered along them as a scanner's
+    // samples are (the set-up reconstructs and simplifies them: seconds of one call into the
+    // core that only replacing the worker can stop).
     const n = 800;
     const lines = [];
     for (let i = 0; i < 625; i += 1) {
       for (let j = 0; j < n; j += 1) {
-        const x = j / n;
+        const x = (j + (0.3 * ((i * 7 + j * 13) % 5)) / 5) / n;
         const y = i / 625;
         lines.push(`${x.toFixed(5)} ${y.toFixed(5)} ${(0.05 * Math.sin(7 * x) * Math.cos(5 * y)).toFixed(5)}`);
       }
     }
+    const sheet = { name: 'sheet.xyz', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n') + '\n') };
     await onFreshPage('cancel', async (fresh) => {
-      await fresh.setInputFiles('#file', { name: 'sheet.xyz', mimeType: 'text/plain', buffer: Buffer.from(lines.join('\n') + '\n') });
+      await fresh.setInputFiles('#file', sheet);
       await fresh.waitForFunction(() => document.getElementById('num-points').textContent === '500,000', null, { timeout: TIMEOUT_MS });
       await fresh.waitForSelector('body[data-fit="idle"]', { timeout: TIMEOUT_MS });
+      const read = await fresh.evaluate(() => window.geofitFit.phases.filter((p) => p.phase === 'reading').pop());
+      assert.equal(read?.done, 1, `the reading was reported to its end: ${JSON.stringify(read)}`);
+      // Drawn within the budget (every 2nd point); all of them on demand.
+      assert.equal(await fresh.evaluate(() => window.geofitFit.drawnPoints), 250_000);
+      await fresh.check('#show-all-points');
+      await fresh.waitForFunction(() => window.geofitFit.drawnPoints === 500_000, null, { timeout: TIMEOUT_MS });
+      await fresh.uncheck('#show-all-points');
+      await fresh.waitForFunction(() => window.geofitFit.drawnPoints === 250_000, null, { timeout: TIMEOUT_MS });
       assert.equal(await fresh.isHidden('#fit-cancel'), true);
+
       await fresh.click('#fit-play');
       await fresh.waitForSelector('body[data-fit="running"]', { timeout: TIMEOUT_MS });
       assert.equal(await fresh.isHidden('#fit-cancel'), false);
-      await fresh.waitForTimeout(500);
+      // The progress line names the set-up's phase and how far it is.
+      await fresh.waitForFunction(() => /^Meshing the points: \d+ %$/.test(document.getElementById('fit-phase').textContent), null, { timeout: TIMEOUT_MS });
+      assert.equal(await fresh.isHidden('#fit-progress-row'), false);
       const [state, ms, framed] = await fresh.evaluate(() => {
         const framed = window.geofitFit.lastStats !== null;
         const t0 = performance.now();
@@ -616,9 +629,21 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       assert.equal(state, 'cancelled');
       assert.ok(ms < 200, `${ms} ms`);
       assert.equal(await fresh.isHidden('#fit-cancel'), true);
-      await pickSample(fresh, 'bun000-points.xyz', '5,032');
+      assert.equal(await fresh.isHidden('#fit-progress-row'), true);
+      assert.equal(await fresh.textContent('#num-points'), '500,000', 'the scan stays loaded');
+
+      // Loaded again (a fresh read in the worker) and fitted with the defaults.
+      const t0 = Date.now();
+      await fresh.setInputFiles('#file', sheet);
+      await fresh.waitForSelector('body[data-state="ready"][data-fit="idle"]', { timeout: TIMEOUT_MS });
       const stats = await playToEnd(fresh);
+      const phases = await fresh.evaluate(() => window.geofitFit.phases.map((p) => `${p.phase} ${Math.round(100 * p.done)}`));
+      console.log(`[e2e] ${backend.name} 500K points loaded again and fitted in ${((Date.now() - t0) / 1000).toFixed(1)} s: ${JSON.stringify(stats)}`);
       assert.equal(stats.status, 'converged', JSON.stringify(stats));
+      for (const phase of ['reading', 'reconstruction', 'simplification', 'setup']) {
+        assert.ok(phases.includes(`${phase} 100`), `${phase} reported to its end: ${phases.join(', ')}`);
+      }
+      assert.equal(await fresh.evaluate(() => window.geofitFit.drawnPoints), 250_000, 'the fit draws its points within the budget too');
     });
   });
 

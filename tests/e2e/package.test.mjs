@@ -30,9 +30,14 @@ window.geofit = {
     const frames = [];
     const onProgress = ({ stats, limit }) =>
       frames.push({ iter: stats.iter, f32: limit.positions instanceof Float32Array, vertices: limit.positions.length / 3 });
-    const r = await fitInWorker(await file(name), name, spec, { onProgress, exports });
+    const phases = [];
+    const onPhase = (phase, done) => {
+      if (phases[phases.length - 1]?.phase !== phase) phases.push({ phase, done });
+      phases[phases.length - 1].done = done;
+    };
+    const r = await fitInWorker(await file(name), name, spec, { onProgress, onPhase, exports });
     const glb = r.exports.glb ? new TextDecoder().decode(r.exports.glb.subarray(0, 4)) : null;
-    return { frames, stats: r.stats, report: r.report, triangles: r.limit.indices.length / 3, glb };
+    return { frames, phases, stats: r.stats, report: r.report, triangles: r.limit.indices.length / 3, glb };
   },
   async cancel(name, spec) {
     const abort = new AbortController();
@@ -158,6 +163,10 @@ describe('the npm package', () => {
         assert.ok(fit.triangles > 1000, `${fit.triangles} triangles`);
         assert.equal(fit.glb, 'glTF');
         assert.equal(fit.report.history.length, fit.stats.iter);
+        // The phases heard: reading, QEM (the bunny mesh is clean: no repair), set-up, then the
+        // iterations, each reported to its end.
+        assert.deepEqual(fit.phases.map((p) => p.phase), ['reading', 'simplification', 'setup', 'iteration'], JSON.stringify(fit.phases));
+        assert.ok(fit.phases.every((p) => p.done === 1), JSON.stringify(fit.phases));
 
         const cancel = await page.evaluate(([s]) => window.geofit.cancel('bunny.obj', s), [{ scheme: 'loop', tolMax: 1e-6, maxIter: 10000 }]);
         assert.deepEqual(cancel, { name: 'AbortError', atAbort: 1, later: 1 });

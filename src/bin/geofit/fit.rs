@@ -382,11 +382,28 @@ fn cli_error(e: FitError) -> String {
     }
 }
 
+/// Runs `f` showing the phase under way and how far it is on one line of stderr, when stderr
+/// is a terminal and the run is not quiet (a big scan's set-up takes seconds to minutes).
+fn with_progress_line<R>(quiet: bool, f: impl FnOnce() -> R) -> R {
+    use std::io::{IsTerminal, Write};
+    if quiet || !std::io::stderr().is_terminal() {
+        return f();
+    }
+    let sink = |phase: geofit::progress::Phase, done: f64| {
+        let mut err = std::io::stderr();
+        let _ = write!(err, "\r\x1b[2K{} {:3.0} %", phase.name(), 100.0 * done);
+        let _ = err.flush();
+    };
+    let result = geofit::progress::watch(Box::new(sink), f);
+    eprint!("\r\x1b[2K");
+    result
+}
+
 pub fn run(args: Args) -> Result<(), String> {
     let start = Instant::now();
     let spec = args.spec()?;
     spec.validate().map_err(cli_error)?;
-    let file = read_input(&args.file)?;
+    let file = with_progress_line(args.quiet, || read_input(&args.file))?;
     let control = match &args.control {
         Some(path) => Some(read_input(path)?.mesh),
         None => None,
@@ -396,8 +413,7 @@ pub fn run(args: Args) -> Result<(), String> {
         ..FitData::from(&file)
     };
     let read_s = start.elapsed().as_secs_f64();
-    let mut fitter = spec
-        .build(&data)
+    let mut fitter = with_progress_line(args.quiet, || spec.build(&data))
         .map_err(|e| format!("{}: {}", args.file.display(), cli_error(e)))?;
     fitter.log_mut().add_precompute(read_s);
     drive(fitter.as_mut(), &args)?;

@@ -37,12 +37,15 @@ use web_time::Instant;
 /// from the split faces), so such a jump means a broken split, not a worse fit.
 const REFINE_WORSE_FACTOR: f64 = 2.0;
 
-/// The set-up's share for its foot points (the spatial index and patches come before, the
-/// surface → data distances after).
+/// Where the set-up's progress stands when the spatial index and patches are built (before
+/// them: the data's reference surface for E_back, made by `build_subdiv_fitter`).
+const SETUP_INDEX: f64 = 0.4;
+
+/// The set-up's share for its foot points (the surface → data distances come after).
 const SETUP_FEET: Part = Part {
     phase: Phase::Setup,
-    from: 0.2,
-    to: 0.9,
+    from: 0.5,
+    to: 0.95,
 };
 
 /// Progress of an iteration: moving the control points (foot points and the solve) takes
@@ -203,7 +206,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         options: SubdivFitOptions,
     ) -> Result<Self, FitError> {
         let start = Instant::now();
-        progress::report(Phase::Setup, 0.0);
+        progress::report(Phase::Setup, SETUP_INDEX);
         options.validate()?;
         crate::geom::check_coordinates(data_points)?;
         if data_points.is_empty() {

@@ -11,6 +11,7 @@ use crate::mesh::{
     detect_features, simplify_with_creases, FeatureOptions, Features, PolyMesh, Simplified,
     SimplifyOptions, SimplifyReport,
 };
+use crate::progress::{self, Phase};
 use crate::subdiv::{Scheme, SubdivSurface};
 use serde::Serialize;
 use web_time::Instant;
@@ -213,6 +214,7 @@ pub(crate) fn build_subdiv_fitter(
         (points, std::borrow::Cow::Borrowed(data), None)
     };
     let start = control_mesh(&mesh, control, initial, features, scheme)?;
+    progress::report(Phase::Setup, 0.0);
     let reference = match reconstruction {
         None => DataSurface::of_mesh(&mesh),
         Some(_) => DataSurface::of_points(&points, &mesh),
