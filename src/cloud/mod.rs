@@ -266,12 +266,13 @@ fn oriented_normals(
     k: usize,
 ) -> (Neighbours, Vec<Vec3>) {
     let tree = Neighbours::new(points);
-    let mut n = normals::pca_normals(points, &tree, k, frame.axes[0]);
+    let near = normals::neighbourhoods(points, &tree, k);
+    let mut n = normals::pca_normals(points, &near, k, frame.axes[0]);
     progress::report(
         Phase::Reconstruction,
         (SPACING_PART.to + MESHING_PART.from) / 2.0,
     );
-    normals::orient(points, &mut n, &tree, k);
+    normals::orient(points, &mut n, &near);
     (tree, n)
 }
 
