@@ -6,8 +6,8 @@
 //! `FitSpec::build` (QEM's passes, the reconstruction's steps, the first foot points), and a
 //! callback threaded through every signature on the way would be an argument a dozen functions
 //! carry for no other use. [`report`] costs one thread-local read when nobody watches, and
-//! hands the sink at most about a hundred reports per phase (a new phase, or one percent more
-//! of it), so a sink may do real work (the page posts a message per report). Reports from other
+//! hands the sink at most about a hundred reports per round of a phase (a new phase, a phase
+//! that starts over, or one percent more of it), so a sink may do real work (the page posts a message per report). Reports from other
 //! threads go nowhere: a phase reports from the thread that drives it.
 
 use std::cell::RefCell;
@@ -80,7 +80,8 @@ pub fn watch<R>(sink: Sink, f: impl FnOnce() -> R) -> R {
 }
 
 /// Reports that `done` (clamped to [0, 1]; NaN counts as 0) of `phase` is done. Passed on when
-/// the phase changed, at its end, or when it moved on by [`STEP`] since the last report.
+/// the phase changed or started over (less done than last reported), at its end, or when it
+/// moved on by [`STEP`] since the last report.
 pub(crate) fn report(phase: Phase, done: f64) {
     let done = if done.is_nan() {
         0.0
@@ -96,7 +97,8 @@ pub(crate) fn report(phase: Phase, done: f64) {
             return;
         };
         let due = match watcher.last {
-            Some((p, d)) if p == phase => done >= d + STEP || (done == 1.0 && d < 1.0),
+            // A phase that starts over (the next iteration, a second QEM run) is a new round.
+            Some((p, d)) if p == phase => done < d || done >= d + STEP || (done == 1.0 && d < 1.0),
             _ => true,
         };
         if due {
@@ -170,6 +172,20 @@ mod tests {
             .map(|s| s.1)
             .collect();
         assert_eq!(setup, [0.0, 1.0]);
+    }
+
+    #[test]
+    fn a_phase_that_starts_over_is_heard_again() {
+        // Iterations in one watched call (`run`): every one is heard from its start to its end.
+        let seen = collect(|| {
+            for _ in 0..3 {
+                report(Phase::Iteration, 0.0);
+                report(Phase::Iteration, 0.6);
+                report(Phase::Iteration, 1.0);
+            }
+        });
+        let done: Vec<f64> = seen.iter().map(|s| s.1).collect();
+        assert_eq!(done, [0.0, 0.6, 1.0, 0.0, 0.6, 1.0, 0.0, 0.6, 1.0]);
     }
 
     #[test]

@@ -90,6 +90,15 @@ fn a_fit_of_bare_points_reports_every_phase_in_order() {
     let d: Vec<f64> = iteration.iter().map(|r| r.1).collect();
     assert_eq!((d[0], *d.last().unwrap()), (0.0, 1.0), "{d:?}");
     assert!(d.len() >= 3, "{d:?}");
+    // Several iterations in one watched call (the wasm `run`): each is heard from its start.
+    let iterations = heard(|| {
+        for _ in 0..2 {
+            fit.step().unwrap();
+        }
+    });
+    let starts = iterations.iter().filter(|r| r.1 == 0.0).count();
+    let ends = iterations.iter().filter(|r| r.1 == 1.0).count();
+    assert_eq!((starts, ends), (2, 2), "{iterations:?}");
 }
 
 #[test]

@@ -118,7 +118,9 @@ function postLoaded(seq) {
     numTriangles: scan.numTriangles,
     strays: scan.strays(),
     diagonal: lo.length === 3 ? Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) : 0,
-    points: everyNth(positions, stride).slice(),
+    // A buffer is transferred once: the points get their own copy only when the mesh sends
+    // the same positions.
+    points: stride === 1 && indices.length > 0 ? positions.slice() : everyNth(positions, stride),
     stride,
     mesh: indices.length > 0 ? { positions, normals: scan.normals(), indices } : null,
   };
