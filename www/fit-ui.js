@@ -194,8 +194,9 @@ class FitPanel {
   /**
    * Has the worker read and parse `file` (a File or Blob called `name`); resolves with the
    * worker's `loaded` message once it is the page's scan (`preset`: the fit options of a
-   * bundled sample), rejects with the reader's error (the previous scan and its fit stay) or,
-   * when a newer load or Cancel overtakes it, with `{ superseded: true }`.
+   * bundled sample), rejects with the reader's error (the previous scan and its fit stay),
+   * with `{ superseded: true }` when a newer load overtakes it, or with `{ cancelled: true }`
+   * when Cancel stops it (the previous scan stays).
    * @param {Blob} file
    * @param {string} name
    * @returns {Promise<import('./protocol.js').LoadedMessage>}
@@ -256,7 +257,7 @@ class FitPanel {
     this.worker = this.startWorker();
     if (this.ui.backColors.checked) this.backColorsChanged();
     if (this.ui.allPoints.checked) this.allPointsChanged();
-    this.loading?.reject({ superseded: true });
+    this.loading?.reject({ cancelled: true });
     this.loading = null;
     // The new worker reads the scan on screen again, in the background.
     if (this.scan) {

@@ -102,12 +102,18 @@ function showPoints(loaded) {
  * @param {string} name
  */
 async function show(file, name, preset = {}) {
+  const before = document.body.dataset.state;
   setState('loading');
   let loaded;
   try {
     loaded = await fitUi.load(file, name, preset);
   } catch (e) {
     if (e?.superseded) return false;
+    if (e?.cancelled) {
+      // The scan shown before (if any) is still the page's.
+      setState(before === 'loading' ? 'ready' : before);
+      return false;
+    }
     showError(`Could not load ${name}: ${e?.message ?? e}`);
     setState('error');
     return false;

@@ -632,6 +632,19 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       assert.equal(await fresh.isHidden('#fit-progress-row'), true);
       assert.equal(await fresh.textContent('#num-points'), '500,000', 'the scan stays loaded');
 
+      // Cancel while the file is read: the scan on screen stays, and the page works on.
+      const cancelledLoad = fresh.evaluate(() => new Promise((resolve) => {
+        new MutationObserver((_, observer) => {
+          if (document.body.dataset.fit !== 'loading') return;
+          observer.disconnect();
+          document.getElementById('fit-cancel').click();
+          setTimeout(() => resolve([document.body.dataset.state, document.body.dataset.fit]), 0);
+        }).observe(document.body, { attributes: true, attributeFilter: ['data-fit'] });
+      }));
+      await fresh.setInputFiles('#file', { ...sheet, name: 'other.xyz' });
+      assert.deepEqual(await cancelledLoad, ['ready', 'cancelled']);
+      assert.equal(await fresh.textContent('#file-name'), 'sheet.xyz', 'the scan shown before stays');
+
       // Loaded again (a fresh read in the worker) and fitted with the defaults.
       const t0 = Date.now();
       await fresh.setInputFiles('#file', sheet);
