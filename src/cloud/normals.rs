@@ -5,15 +5,26 @@
 use super::neighbours::Neighbours;
 use crate::geom::principal_frame;
 use crate::geom::{Point3, Vec3};
+use crate::progress::{self, Part};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// The `k + 1` nearest points of every point, nearest first (the point itself among them): the
 /// neighbourhoods of [`pca_normals`] (the first `k`) and the graph of [`orient`], found once.
-pub(super) fn neighbourhoods(points: &[Point3], tree: &Neighbours, k: usize) -> Vec<Vec<u32>> {
+/// Reports its progress as `part`.
+pub(super) fn neighbourhoods(
+    points: &[Point3],
+    tree: &Neighbours,
+    k: usize,
+    part: Part,
+) -> Vec<Vec<u32>> {
     points
         .iter()
-        .map(|&p| {
+        .enumerate()
+        .map(|(i, &p)| {
+            if i % progress::BATCH == 0 {
+                part.count(i, points.len());
+            }
             tree.nearest(p, k + 1)
                 .iter()
                 .map(|&(i, _)| i as u32)
