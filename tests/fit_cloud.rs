@@ -254,7 +254,14 @@ fn bare_points_are_measured_to_themselves_not_to_their_reconstruction() {
     let rebuilt = DataSurface::of_mesh(&made.mesh)
         .expect("faces")
         .measure(&centroids, diagonal);
-    assert_eq!(own.over_holes, 0, "a closed reconstruction has no holes");
+    // The reconstruction is closed but for the few triangles it drops as strays (6 on spot):
+    // centroids over those holes are left out of the statistics, and they must be few.
+    assert!(
+        own.over_holes * 50 <= centroids.len(),
+        "{} of {} over holes",
+        own.over_holes,
+        centroids.len()
+    );
     assert!(own.max_pct < 0.5 && own.p99_pct < 0.35, "{own:?}");
     assert!(
         rebuilt.max_pct > 4.0 * own.max_pct,
@@ -296,4 +303,45 @@ fn bare_points_of_a_closed_scan_converge_both_ways_onto_the_scanned_surface() {
             .fold(0.0f64, f64::max);
         assert!(100.0 * worst / diagonal <= 1.1, "{scheme:?}: {worst}");
     }
+}
+
+/// cheburashka's 6,669 vertices as bare points: sparse (0.8 % of the diagonal apart) and
+/// uneven, with thin ears. The implicit surface of such points also has a zero set where no
+/// point is; its contour ran up to 9.6 % of the diagonal from cheburashka's own mesh, and a
+/// Loop fit from it stalled at E_back 3.0 % with a sheet 3.2 % from the mesh. The stray
+/// triangles are dropped (and reported): the reconstruction stays within 3 % of the mesh, and
+/// the fit converges both ways.
+#[test]
+fn sparse_uneven_points_reconstruct_without_stray_sheets_and_fit() {
+    let path = common::data_dir().join("corpus/cheburashka.obj");
+    let Ok(file) = geofit::io::read_path(&path) else {
+        eprintln!("skipped: no corpus/cheburashka.obj");
+        return;
+    };
+    let truth = file.mesh;
+    let points = truth.positions().to_vec();
+    let truth_surface = DataSurface::of_mesh(&truth).expect("faces");
+    let diagonal = truth.bbox().expect("points").diagonal();
+    let made = geofit::cloud::reconstruct(&points, None, &Default::default()).expect("closed");
+    assert!(made.stray_triangles > 0, "the strays are reported");
+    let worst = made
+        .mesh
+        .positions()
+        .iter()
+        .filter_map(|&p| truth_surface.distance(p))
+        .fold(0.0f64, f64::max);
+    assert!(100.0 * worst / diagonal <= 3.0, "{}", 100.0 * worst / diagonal);
+
+    let cloud = PolyMesh::from_points(points).expect("finite points");
+    let mut fitter = FitSpec::defaults(Scheme::Loop)
+        .build(&FitData::points(&cloud))
+        .expect("a fitter");
+    let status = fitter.run().expect("runs");
+    let back = fitter.back_stats().expect("E_back measured").max_pct;
+    assert_eq!(status, FitStatus::Converged, "E_back {back} %");
+    assert!(
+        fitter.log().intake_notes().iter().any(|n| n.contains("dropped where no point")),
+        "{:?}",
+        fitter.log().intake_notes()
+    );
 }

@@ -12,8 +12,11 @@
 //! - **Closed** objects (points all around): normals by PCA over the k nearest neighbours,
 //!   oriented consistently along a minimum spanning tree (Hoppe et al. 1992), then the zero set
 //!   of an implicit moving-least-squares signed distance contoured by marching tetrahedra (its
-//!   slivers collapsed): a watertight manifold wherever the sampling is closed. Its vertices
-//!   are new points.
+//!   slivers collapsed): a watertight manifold wherever the sampling is closed and even
+//!   enough. Its vertices are new points. Where the sampling is sparse or uneven (thin parts,
+//!   a decimated mesh's vertices) the zero set also runs where no point is — sheets and blobs
+//!   up to 10 % of the diagonal from the points — and those contour triangles are dropped
+//!   (`closed::without_strays`), leaving holes that the fit may span.
 //!
 //! Either way the result is one manifold, consistently oriented piece; for fitting, keep the
 //! input points as the data and use the mesh only to start from (e.g. through
@@ -168,6 +171,9 @@ pub struct Reconstruction {
     pub outliers: usize,
     /// Per input point: whether it survived outlier removal (all `true` without it).
     pub inlier: Vec<bool>,
+    /// Closed objects: contour triangles dropped because they strayed from the points (see
+    /// the module docs); the mesh has holes there. 0 for open scans.
+    pub stray_triangles: usize,
 }
 
 /// Neighbours for spacing estimates and the outlier test.
@@ -238,11 +244,14 @@ pub fn reconstruct(
         (None, Some((_, normals))) => detect_kind(normals, &frame),
         (None, None) => SurfaceKind::Open,
     };
-    let mesh = match (kind, oriented) {
+    let (mesh, stray_triangles) = match (kind, oriented) {
         (SurfaceKind::Closed, Some((tree, normals))) => {
             closed_mesh(&kept, &normals, &tree, &spacing, &inlier, options)?
         }
-        _ => open_mesh(points, grid, &inlier, &spacing, &frame, options)?,
+        _ => (
+            open_mesh(points, grid, &inlier, &spacing, &frame, options)?,
+            0,
+        ),
     };
     progress::report(Phase::Reconstruction, 1.0);
     Ok(Reconstruction {
@@ -250,6 +259,7 @@ pub fn reconstruct(
         kind,
         outliers,
         inlier,
+        stray_triangles,
     })
 }
 
@@ -320,7 +330,7 @@ fn closed_mesh(
     spacing: &[f64],
     inlier: &[bool],
     options: &ReconstructOptions,
-) -> Result<PolyMesh, ReconstructError> {
+) -> Result<(PolyMesh, usize), ReconstructError> {
     let kept_spacing: Vec<f64> = spacing
         .iter()
         .zip(inlier)
@@ -332,13 +342,14 @@ fn closed_mesh(
         cell = crate::geom::principal_frame(kept.iter().copied()).values[2].sqrt() * 1e-2;
     }
     let (positions, tris) = closed::contour(kept, normals, tree, cell, BAND_CELLS, MESHING_PART);
+    let (tris, strays) = closed::without_strays(&positions, tris, tree, &kept_spacing);
     let tris = cleanup::manifold_part(tris, positions.len());
     if tris.is_empty() {
         return Err(ReconstructError::NoSurface);
     }
     let (positions, tris) = compact(positions, tris);
     let mesh = PolyMesh::try_new(positions, tris).map_err(|_| ReconstructError::NoSurface)?;
-    Ok(without_slivers(mesh))
+    Ok((without_slivers(mesh), strays))
 }
 
 /// `mesh` with the slivers marching tetrahedra leaves (contour vertices a hair apart where the

@@ -174,6 +174,13 @@ impl FitLog {
                 "reconstructed {} surface ({}): {} triangles, {} outliers removed",
                 r.kind, r.method, r.triangles, r.outliers
             ));
+            if r.stray_triangles > 0 {
+                notes.push(format!(
+                    "{} triangles of the implicit surface dropped where no point was near \
+                     (holes the fit may span)",
+                    r.stray_triangles
+                ));
+            }
         }
         if let Some(s) = &self.simplification {
             if s.repair.changed() {

@@ -190,6 +190,8 @@ export interface ReconstructionReport {
   outliers: number;
   vertices: number;
   triangles: number;
+  /** Closed objects: triangles of the implicit surface dropped where no point was near. */
+  stray_triangles: number;
   seconds: number;
 }
 

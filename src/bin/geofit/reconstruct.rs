@@ -64,6 +64,7 @@ pub fn run(args: Args) -> Result<(), String> {
         "outliers": result.outliers,
         "vertices": result.mesh.num_vertices(),
         "triangles": result.mesh.num_triangles(),
+        "stray_triangles": result.stray_triangles,
         "reconstruct_s": seconds,
         "deviation_max_pct": dev.map(|d| d.max),
         "deviation_rms_pct": dev.map(|d| d.rms),

@@ -176,6 +176,9 @@ pub struct ReconstructionReport {
     pub vertices: usize,
     /// Triangles of the reconstructed mesh.
     pub triangles: usize,
+    /// Closed objects: triangles of the implicit surface dropped because they strayed from
+    /// the points (the mesh has holes there; see [`crate::cloud`]).
+    pub stray_triangles: usize,
     /// Seconds the reconstruction took (included in the report's `precompute_s`).
     pub seconds: f64,
 }
@@ -285,6 +288,7 @@ fn reconstruct_cloud(
         outliers: rec.outliers,
         vertices: used_vertices(&rec.mesh),
         triangles: rec.mesh.num_triangles(),
+        stray_triangles: rec.stray_triangles,
         seconds: start.elapsed().as_secs_f64(),
     };
     Ok((kept, rec.mesh, report))
