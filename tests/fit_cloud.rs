@@ -330,7 +330,11 @@ fn sparse_uneven_points_reconstruct_without_stray_sheets_and_fit() {
         .iter()
         .filter_map(|&p| truth_surface.distance(p))
         .fold(0.0f64, f64::max);
-    assert!(100.0 * worst / diagonal <= 3.0, "{}", 100.0 * worst / diagonal);
+    assert!(
+        100.0 * worst / diagonal <= 3.0,
+        "{}",
+        100.0 * worst / diagonal
+    );
 
     let cloud = PolyMesh::from_points(points).expect("finite points");
     let mut fitter = FitSpec::defaults(Scheme::Loop)
@@ -340,7 +344,11 @@ fn sparse_uneven_points_reconstruct_without_stray_sheets_and_fit() {
     let back = fitter.back_stats().expect("E_back measured").max_pct;
     assert_eq!(status, FitStatus::Converged, "E_back {back} %");
     assert!(
-        fitter.log().intake_notes().iter().any(|n| n.contains("dropped where no point")),
+        fitter
+            .log()
+            .intake_notes()
+            .iter()
+            .any(|n| n.contains("dropped where no point")),
         "{:?}",
         fitter.log().intake_notes()
     );
