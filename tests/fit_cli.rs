@@ -261,3 +261,51 @@ fn a_web_across_a_gap_of_the_data_is_pulled_onto_it() {
     }
     std::fs::remove_file(&json).ok();
 }
+
+/// `--threads N` gives byte-identical results on any number of threads: the cage and the
+/// limit surface of a subdivision fit (foot points and surface → data distances run in
+/// parallel), of bare points (reconstructed, measured to their discs), and a B-spline surface
+/// (parameter correction in parallel), with every error figure of the reports equal.
+#[test]
+fn results_are_the_same_on_any_number_of_threads() {
+    let samples = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/samples");
+    let dir = std::env::temp_dir().join(format!("geofit-threads-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let cases = [
+        ("bunny.obj", "loop", "--cage"),
+        ("bun000-points.xyz", "catmull-clark", "--cage"),
+        ("bun000-points.xyz", "bspline", "--surface-json"),
+    ];
+    for (file, scheme, export) in cases {
+        let run = |threads: &str| {
+            let out = dir.join(format!("{scheme}-{threads}.out"));
+            let json = dir.join(format!("{scheme}-{threads}.json"));
+            geofit_ok(&[
+                "fit",
+                samples.join(file).to_str().expect("utf-8"),
+                "--scheme",
+                scheme,
+                "--threads",
+                threads,
+                "-q",
+                export,
+                out.to_str().expect("utf-8"),
+                "--json",
+                json.to_str().expect("utf-8"),
+            ]);
+            let report = read_json(&json);
+            let errors: Vec<String> = ["e_avg_pct", "e_max_pct", "e_rms_pct", "e_back_max_pct"]
+                .iter()
+                .map(|k| report[k].to_string())
+                .collect();
+            (
+                std::fs::read(&out).expect("export"),
+                errors,
+                report["iterations"].clone(),
+            )
+        };
+        let one = run("1");
+        assert_eq!(one, run("3"), "{file} {scheme}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -19,7 +19,7 @@ mod curve;
 mod deviation;
 mod error;
 mod log;
-mod parallel;
+pub(crate) mod parallel;
 mod reference;
 mod report;
 mod spec;
@@ -39,6 +39,7 @@ pub use curve::{
 pub use deviation::{DeviationHistogram, DeviationStats};
 pub use error::FitError;
 pub use log::FitLog;
+pub use parallel::{max_threads, set_max_threads};
 pub use reference::{BackStats, DataSurface};
 pub use report::{within_tolerance_pct, FitReport};
 pub use spec::{Cloud, FitData, FitSpec, Method, OptionInfo, Scheme, OPTION_TABLE};

@@ -326,9 +326,10 @@ impl DataSurface {
         ))
     }
 
-    /// The distance of every one of `samples` to the data ([`DataSurface::distance`]).
+    /// The distance of every one of `samples` to the data ([`DataSurface::distance`]), on
+    /// several threads when there are many (the same result on any number).
     pub fn distances(&self, samples: &[Point3]) -> Vec<Option<f64>> {
-        samples.iter().map(|&p| self.distance(p)).collect()
+        super::parallel::map(samples, |&p| self.distance(p))
     }
 
     /// The surface → data statistics of `samples` (points of a fitted surface), relative to a

@@ -69,7 +69,7 @@ impl FitState {
         let Some(reference) = &self.reference else {
             return Vec::new();
         };
-        samples.iter().map(|&p| reference.closest(p)).collect()
+        super::parallel::map(samples, |&p| reference.closest(p))
     }
 
     /// Sets the surface → data statistics to those of `closest` (from

@@ -27,6 +27,10 @@ mod subdiv;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Threads for the parallel parts of a fit (foot points, surface → data distances);
+    /// default: every core, or GEOFIT_THREADS. Results are the same on any number.
+    #[arg(long, global = true, value_parser = clap::value_parser!(u16).range(1..))]
+    threads: Option<u16>,
 }
 
 // Parsed once per process: the size of the `fit` variant (it carries the B-spline options too)
@@ -54,6 +58,9 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        geofit::fit::set_max_threads(usize::from(n));
+    }
     let result = match cli.command {
         Command::Info(args) => info::run(args),
         Command::ExportSamples(args) => export_samples::run(args),

@@ -4,7 +4,7 @@
 
 use super::index::SurfaceIndex;
 use super::{FootPoint, SubdivFitOptions};
-use crate::fit::{FitData, FitError, FitSpec, FitStatus, Fitter};
+use crate::fit::{parallel, FitData, FitError, FitSpec, FitStatus, Fitter};
 use crate::geom::{ClosestPoint, NewtonOptions, Point3};
 use crate::progress::{self, Part, Phase};
 use crate::subdiv::{LimitSurface, SubdivSurface, SurfaceParam};
@@ -48,33 +48,37 @@ pub(crate) fn warm_foot<S: ClosestPoint<Param = SurfaceParam>>(
     foot
 }
 
-/// Every point's foot point from the spatial index ([`cold_foot`]). `Err(i)` names a point the
-/// index has nothing near. Reports its progress as `part`.
+/// Every point's foot point from the spatial index ([`cold_foot`]). `Err(i)` names the first
+/// point the index has nothing near. Reports its progress as `part`, block by block; the
+/// points of a block are searched on several threads ([`crate::fit::max_threads`]; the same
+/// result on any number).
 ///
 /// Points are visited in data order: scans list their points in a spatially coherent order, so
 /// consecutive searches mostly share patches. (Visiting them grouped by patch was measured
 /// slower: the scattered reads and writes of the points cost more than the patch data they
 /// share.)
-pub(crate) fn cold_feet<S: ClosestPoint<Param = SurfaceParam>>(
+pub(crate) fn cold_feet<S: ClosestPoint<Param = SurfaceParam> + Sync>(
     surface: &S,
     index: &SurfaceIndex,
     data: &[Point3],
     opts: &NewtonOptions,
     part: Part,
 ) -> Result<Vec<FootPoint>, usize> {
-    data.iter()
-        .enumerate()
-        .map(|(i, &p)| {
-            if i % progress::BATCH == 0 {
-                part.count(i, data.len());
-            }
-            cold_foot(surface, index, p, opts).ok_or(i)
-        })
-        .collect()
+    let block = progress::BATCH * crate::fit::max_threads();
+    let mut feet = Vec::with_capacity(data.len());
+    for (b, points) in data.chunks(block).enumerate() {
+        part.count(b * block, data.len());
+        let found = parallel::map(points, |&p| cold_foot(surface, index, p, opts));
+        for (k, foot) in found.into_iter().enumerate() {
+            feet.push(foot.ok_or(b * block + k)?);
+        }
+    }
+    Ok(feet)
 }
 
-/// Every point's foot point from its previous one ([`warm_foot`]) into `out`.
-pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam>>(
+/// Every point's foot point from its previous one ([`warm_foot`]) into `out`, on several
+/// threads (the same result on any number).
+pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam> + Sync>(
     surface: &S,
     index: &SurfaceIndex,
     data: &[Point3],
@@ -83,9 +87,9 @@ pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam>>(
     slack: f64,
     out: &mut [FootPoint],
 ) {
-    for ((o, &p), prev) in out.iter_mut().zip(data).zip(previous) {
-        *o = warm_foot(surface, index, p, prev, opts, slack);
-    }
+    parallel::fill(out, |i| {
+        warm_foot(surface, index, data[i], &previous[i], opts, slack)
+    });
 }
 
 /// The benchmark's searches report as a whole set-up.

@@ -16,6 +16,7 @@ pub(crate) use setup::find_creases;
 pub use setup::{default_initial_count, initial_control, CreaseReport, ReconstructionReport};
 
 use super::accel::Accelerator;
+use super::parallel;
 use super::stall::{stalled, STALL_WINDOW};
 use super::{
     Acceleration, DataSurface, FitError, FitLog, FitState, FitStatus, Fitter, Method, Scheme,
@@ -99,7 +100,7 @@ type FootPoint = Nearest<SurfaceParam>;
 
 /// A limit surface the fitter can rebuild from a control mesh, so that refinement (which changes
 /// the connectivity) can continue with the same scheme.
-pub trait ControlSurface: LimitSurface + ClosestPoint<Param = SurfaceParam> + Sized {
+pub trait ControlSurface: LimitSurface + ClosestPoint<Param = SurfaceParam> + Sized + Sync {
     /// The subdivision scheme.
     fn scheme(&self) -> crate::subdiv::Scheme;
 
@@ -730,10 +731,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
 
     /// The distance to the data of the surface at `params`, with the nearest data point.
     fn closest_at(&self, params: &[SurfaceParam]) -> Vec<Option<(f64, Point3)>> {
-        let samples: Vec<Point3> = params
-            .iter()
-            .map(|&at| self.surface.eval(at).point)
-            .collect();
+        let samples = parallel::map(params, |&at| self.surface.eval(at).point);
         self.state.closest_data(&samples)
     }
 
