@@ -10,7 +10,7 @@ import { validateBytes } from 'gltf-validator';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import { startServer } from '../../scripts/serve.mjs';
 import { join } from 'node:path';
-import { BACKENDS, ROOT, countPixels, launch, loadGlbWithThree, saveArtifact } from './helpers.mjs';
+import { BACKENDS, LONG_TASK_MS, ROOT, countPixels, launch, loadGlbWithThree, saveArtifact } from './helpers.mjs';
 
 const TIMEOUT_MS = 180_000;
 const TOL_MAX = 0.5;
@@ -277,8 +277,8 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
     assert.equal(api.eMaxPct, stats.eMaxPct);
   });
 
-  test('no main-thread task over 50 ms during the fit', () => {
-    assert.deepEqual(fitLongTasks, []);
+  test(`no main-thread task over ${LONG_TASK_MS} ms during the fit`, () => {
+    assert.deepEqual(fitLongTasks.filter((ms) => ms > LONG_TASK_MS), []);
   });
 
   test('the converged view and the chart are drawn', async () => {
