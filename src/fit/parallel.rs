@@ -34,9 +34,6 @@ pub fn max_threads() -> usize {
         return 1;
     }
     *MAX.get_or_init(|| {
-        if cfg!(target_arch = "wasm32") {
-            return 1;
-        }
         let given = std::env::var("GEOFIT_THREADS")
             .ok()
             .and_then(|v| v.trim().parse::<usize>().ok())
@@ -154,17 +151,12 @@ where
         f(a, b, c);
         return;
     }
-    let size = a.len().div_ceil(threads);
-    let f = &f;
-    std::thread::scope(|scope| {
-        let chunks = a
-            .chunks(size)
-            .zip(b.chunks_mut(size))
-            .zip(c.chunks_mut(size));
-        for ((a, b), c) in chunks {
-            scope.spawn(move || f(a, b, c));
-        }
-    });
+    let size = chunk_size(a.len(), threads);
+    let chunks = a
+        .chunks(size)
+        .zip(b.chunks_mut(size))
+        .zip(c.chunks_mut(size));
+    claim_chunks(chunks.collect(), threads, |_, ((a, b), c)| f(a, b, c));
 }
 
 #[cfg(test)]
