@@ -53,5 +53,28 @@ for name, rs in runs.items():
         cpus += f" (median {statistics.median(x[1] for x in rs):.2f})"
     print(f"| {name} | {r['converged']} | {r['iterations']} | {r['initial_control_points']} → {r['final_control_points']} | "
           f"{r['e_avg_pct']:.4f} | {r['e_max_pct']:.4f} | {r['e_rms_pct']:.4f} | {r['precompute_s']:.2f} | {r['fit_s']:.2f} | {total} | {cpus} |")
+# Where the time goes: per phase of the fastest headline run, summed over its iterations and as a
+# mean per iteration with and without a refinement ("other" is the rest of each iteration).
+name = "loop-basis-cg"
+if name in runs:
+    r = runs[name][0][0]
+    phases = ["moves_ms", "feet_ms", "back_ms", "refine_ms"]
+    print()
+    print(f"Phases of {name} (fastest run), ms:")
+    print()
+    print("| iterations | count | moves | foot points | surface → data | refinement | other | total |")
+    print("|---|---|---|---|---|---|---|---|")
+    def row(label, hs, mean):
+        if not hs:
+            return
+        div = len(hs) if mean else 1
+        sums = [sum(h.get("phases", {}).get(p, 0.0) for h in hs) / div for p in phases]
+        total = sum(h["ms"] for h in hs) / div
+        cells = " | ".join(f"{v:.1f}" for v in sums + [total - sum(sums), total])
+        print(f"| {label} | {len(hs)} | {cells} |")
+    history = r["history"]
+    row("all (sum)", history, False)
+    row("without refinement (mean)", [h for h in history if not h["refined"]], True)
+    row("with refinement (mean)", [h for h in history if h["refined"]], True)
 PY
 rm -rf "$out"

@@ -61,6 +61,7 @@ impl FitLog {
             refined,
             e_back_max_pct: back.map(|b| b.max_pct),
             e_back_p99_pct: back.map(|b| b.p99_pct),
+            phases: None,
         });
         self.status = status;
         status
@@ -71,6 +72,13 @@ impl FitLog {
         if let Some(last) = self.history.last_mut() {
             last.e_back_max_pct = back.map(|b| b.max_pct);
             last.e_back_p99_pct = back.map(|b| b.p99_pct);
+        }
+    }
+
+    /// Sets where the last iteration's time went.
+    pub(crate) fn set_phases(&mut self, phases: super::PhaseTimes) {
+        if let Some(last) = self.history.last_mut() {
+            last.phases = Some(phases);
         }
     }
 

@@ -44,7 +44,7 @@ pub use reference::{BackStats, DataSurface};
 pub use report::{within_tolerance_pct, FitReport};
 pub use spec::{Cloud, FitData, FitSpec, Method, OptionInfo, Scheme, OPTION_TABLE};
 pub use state::{FitState, BACK_TOLERANCE_FACTOR};
-pub use stats::{ErrorStats, IterationRecord, Tolerances};
+pub use stats::{ErrorStats, IterationRecord, PhaseTimes, Tolerances};
 pub use strays::StrayPoints;
 pub use subdiv::{
     default_initial_count, initial_control, surface_of, ControlSurface, CreaseReport,

@@ -84,6 +84,7 @@ mod tests {
             refined: false,
             e_back_max_pct: None,
             e_back_p99_pct: None,
+            phases: None,
         }
     }
 

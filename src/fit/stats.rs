@@ -153,6 +153,31 @@ pub struct IterationRecord {
     /// Surface → data: the 99th-percentile distance, %.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub e_back_p99_pct: Option<f64>,
+    /// Where the iteration's time went (subdivision fits).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phases: Option<PhaseTimes>,
+}
+
+/// Where one iteration of a subdivision fit spent its time, ms; the rest of the iteration's
+/// `ms` is bookkeeping (statistics, weights, the stall rule). Kept per iteration in the report
+/// so that a speed-up is judged by the phase it targets (`scripts/bench_fit.sh` tabulates it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PhaseTimes {
+    /// Working out the move: stencils and conjugate gradients (or the weighted error sums).
+    pub moves_ms: f64,
+    /// Foot points on the moved surface (Newton from the last ones), damping retries included.
+    pub feet_ms: f64,
+    /// The surface → data measure: evaluating samples and finding their nearest data.
+    pub back_ms: f64,
+    /// Refinement: splits, flips, the rebuilt patches and their foot points.
+    pub refine_ms: f64,
+}
+
+impl PhaseTimes {
+    /// Adds the milliseconds since `start` to the phase `slot` picks.
+    pub(crate) fn add(&mut self, slot: fn(&mut PhaseTimes) -> &mut f64, start: web_time::Instant) {
+        *slot(self) += start.elapsed().as_secs_f64() * 1e3;
+    }
 }
 
 #[cfg(test)]

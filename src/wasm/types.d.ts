@@ -124,6 +124,20 @@ export interface IterationRecord {
   refined: boolean;
   e_back_max_pct?: number;
   e_back_p99_pct?: number;
+  /** Where a subdivision fit's iteration spent its time; the rest of `ms` is bookkeeping. */
+  phases?: PhaseTimes;
+}
+
+/** One iteration's time by phase, ms (`IterationRecord.phases`). */
+export interface PhaseTimes {
+  /** Stencils and conjugate gradients (or the weighted error sums). */
+  moves_ms: number;
+  /** Foot points on the moved surface, damping retries included. */
+  feet_ms: number;
+  /** The surface → data measure. */
+  back_ms: number;
+  /** Splits, flips, rebuilt patches and their foot points. */
+  refine_ms: number;
 }
 
 /** How many, and the first few of them. */
