@@ -20,6 +20,7 @@ pub struct FitLog {
     simplification: Option<SimplifyReport>,
     creases: Option<CreaseReport>,
     strays: Option<StrayPoints>,
+    went_back_to: Option<usize>,
 }
 
 impl FitLog {
@@ -35,6 +36,7 @@ impl FitLog {
             simplification: None,
             creases: None,
             strays: None,
+            went_back_to: None,
         }
     }
 
@@ -72,6 +74,16 @@ impl FitLog {
         if let Some(last) = self.history.last_mut() {
             last.e_back_max_pct = back.map(|b| b.max_pct);
             last.e_back_p99_pct = back.map(|b| b.p99_pct);
+        }
+    }
+
+    /// Replaces the data → surface figures of the last record with `stats` (the state a
+    /// stopped fit ends in when it goes back to a better iteration).
+    pub(crate) fn amend_stats(&mut self, stats: &ErrorStats) {
+        if let Some(last) = self.history.last_mut() {
+            last.e_avg_pct = stats.e_avg_pct;
+            last.e_max_pct = stats.e_max_pct;
+            last.e_rms_pct = stats.e_rms_pct;
         }
     }
 
@@ -164,6 +176,16 @@ impl FitLog {
     /// Records the sharp features found and kept.
     pub(crate) fn set_creases(&mut self, report: Option<CreaseReport>) {
         self.creases = report;
+    }
+
+    /// The iteration whose control points the fit went back to when it stopped.
+    pub fn went_back_to(&self) -> Option<usize> {
+        self.went_back_to
+    }
+
+    /// Records that the fit went back to the control points of `iteration`.
+    pub(crate) fn set_went_back_to(&mut self, iteration: usize) {
+        self.went_back_to = Some(iteration);
     }
 
     /// Records the data points left out as strays.

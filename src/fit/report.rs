@@ -60,6 +60,10 @@ pub struct FitReport {
     /// The data points left out as strays (absent when there were none).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub strays: Option<StrayPoints>,
+    /// The iteration whose control points a fit that stopped unconverged went back to, being
+    /// better than where it stopped (absent when it ends where it stopped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ended_at_iteration: Option<usize>,
     /// What happened to the data before the first iteration, for people
     /// ([`FitLog::intake_notes`](super::FitLog::intake_notes)).
     pub intake: Vec<String>,
@@ -109,6 +113,7 @@ impl FitReport {
             simplification: log.simplification().cloned(),
             creases: log.creases().cloned(),
             strays: log.strays().cloned(),
+            ended_at_iteration: log.went_back_to(),
             intake: log.intake_notes(),
             precompute_s,
             fit_s,

@@ -205,6 +205,34 @@ impl FitState {
         self.log.amend_back(self.back);
     }
 
+    /// Writes the current data → surface statistics into the last iteration's record.
+    pub(crate) fn amend_stats(&mut self) {
+        self.log.amend_stats(&self.stats);
+    }
+
+    /// How far the current state is from meeting the tolerances: the largest ratio of a
+    /// statistic to its tolerance, E_back's to its bound (E_rms itself without tolerances).
+    /// Lower is better; below 1 everything is met.
+    pub(crate) fn shortfall(&self) -> f64 {
+        let t = self.tolerances;
+        let s = self.stats;
+        let ratios = [
+            t.avg_pct.map(|v| s.e_avg_pct / v),
+            t.max_pct.map(|v| s.e_max_pct / v),
+            t.rms_pct.map(|v| s.e_rms_pct / v),
+            t.max_pct
+                .zip(self.back)
+                .map(|(v, b)| b.max_pct / (BACK_TOLERANCE_FACTOR * v)),
+        ];
+        let worst = ratios.into_iter().flatten().fold(f64::NAN, f64::max);
+        let worst = if worst.is_nan() { s.e_rms_pct } else { worst };
+        if worst.is_nan() {
+            f64::INFINITY
+        } else {
+            worst
+        }
+    }
+
     /// Closes the iteration that began at `start` with `control_points` control points.
     pub(crate) fn record(
         &mut self,

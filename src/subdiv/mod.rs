@@ -160,6 +160,10 @@ pub trait LimitSurface {
     fn set_control_points(&mut self, points: &[Point3]);
     /// Limit position and derivatives at `at`.
     fn eval(&self, at: SurfaceParam) -> LimitEval;
+    /// Limit position at `at`, where derivatives are not needed.
+    fn point(&self, at: SurfaceParam) -> Point3 {
+        self.eval(at).point
+    }
     /// Appends `(control index, weight)` with `S(at) = Σ weight · P[index]` to `out`.
     fn stencil(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>);
     /// Appends the patent's local weights of `at` (SPEC §1.6) to `out`: barycentric (triangle)

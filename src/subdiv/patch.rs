@@ -960,6 +960,23 @@ impl Graph {
         }
     }
 
+    /// [`Graph::point`] through the shortcut `id`.
+    pub fn point_shortcut(&self, id: u32, cache: &[Vec3], u: f64, v: f64) -> Point3 {
+        match self.entry(id, u, v) {
+            Some(Entry::Deep {
+                offset,
+                node,
+                kd,
+                map,
+                ..
+            }) => {
+                let (lu, lv) = map.apply(u, v);
+                self.point(*node, &cache[*offset..*offset + kd], lu, lv)
+            }
+            _ => self.eval_shortcut(id, cache, u, v).point,
+        }
+    }
+
     /// Weights of the patch's local points for the limit position at (u, v), through the
     /// shortcut `id`.
     pub fn stencil_shortcut(&self, id: u32, u: f64, v: f64, out: &mut Vec<f64>) {
@@ -1189,6 +1206,24 @@ impl Graph {
         }
     }
 
+    /// Limit point at (u, v) of the patch `root` whose local points are `pts`. At a corner of
+    /// the domain it is the corner's limit mask: [`Graph::eval`] would subdivide towards an
+    /// extraordinary corner [`MAX_DEPTH`] + [`EXTRA_DEPTH`] times for derivatives a point does
+    /// not need, and the surface → data measure samples every patch's first corner.
+    pub fn point(&self, root: u32, pts: &[Point3], u: f64, v: f64) -> Point3 {
+        if let Node::Split { corner_masks, .. } = &self.nodes[root as usize] {
+            let corner = corner_params(self.scheme)
+                .iter()
+                .position(|c| c[0] == u && c[1] == v);
+            if let Some(mask) = corner.and_then(|c| corner_masks.get(c)) {
+                if let Some(p) = mask_point(mask, pts) {
+                    return p;
+                }
+            }
+        }
+        self.eval(root, pts, u, v).point
+    }
+
     /// Limit point and derivatives at (u, v) of the patch `root` whose local points are `pts`.
     pub fn eval(&self, root: u32, pts: &[Point3], u: f64, v: f64) -> LimitEval {
         let path = self.descend(root, u, v);
@@ -1326,6 +1361,17 @@ fn nearest_corner(scheme: Scheme, u: f64, v: f64) -> usize {
             d(i).total_cmp(&d(j))
         })
         .unwrap_or(0)
+}
+
+/// The point a limit `mask` makes of `pts`, relative to the first (as [`Graph::eval`] keeps
+/// them); `None` when the mask reaches past `pts`.
+fn mask_point(mask: &[(u16, f64)], pts: &[Point3]) -> Option<Point3> {
+    let origin = *pts.first()?;
+    let mut sum = Vec3::ZERO;
+    for &(i, w) in mask {
+        sum += (*pts.get(i as usize)? - origin) * w;
+    }
+    Some(origin + sum)
 }
 
 fn mul2(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {

@@ -412,6 +412,18 @@ impl LimitSurface for SubdivSurface {
         }
     }
 
+    fn point(&self, at: SurfaceParam) -> Point3 {
+        let Some((p, u, v)) = self.patch(at) else {
+            return Point3::ZERO;
+        };
+        let cache = &self.cache[p.cache as usize..];
+        if p.direct {
+            self.graph.power().eval(cache, u, v).point
+        } else {
+            self.graph.point_shortcut(p.shortcut, cache, u, v)
+        }
+    }
+
     fn stencil(&self, at: SurfaceParam, out: &mut Vec<(u32, f64)>) {
         let Some((p, u, v)) = self.patch(at) else {
             return;

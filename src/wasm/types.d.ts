@@ -268,6 +268,8 @@ export interface FitReportCommon {
   simplification?: SimplifyReport;
   creases?: CreaseReport;
   strays?: { indices: number[] };
+  /** The iteration whose control points a fit that stopped unconverged went back to. */
+  ended_at_iteration?: number;
   intake: string[];
   precompute_s: number;
   fit_s: number;

@@ -471,6 +471,10 @@ fn drive(fitter: &mut dyn Fitter, args: &Args) -> Result<(), String> {
     let back = report
         .e_back_max_pct
         .map_or(String::new(), |b| format!(", E_back {b:.4}%"));
+    let back = match report.ended_at_iteration {
+        Some(k) => format!("{back} (iteration {k}'s control points: the best)"),
+        None => back,
+    };
     outln!(
         "{}: {} after {} iterations, {} -> {} control points, E_avg {:.5}% E_max {:.5}% E_rms {:.5}%{}{}, precompute {:.2} s, fit {:.2} s, total {:.2} s",
         report.scheme,
