@@ -62,9 +62,10 @@ fn a_converged_fit_lies_on_the_data_at_every_tessellation_vertex() {
     }
 }
 
-/// A fit that stops unconverged ends at its best iteration since the last refinement: the
-/// bunny at Table 1 model C (Loop) trades E_max for E_back late on (one iteration went from
-/// E_max 0.047 % to 0.43 %), and stalled on such an iteration before it went back.
+/// A fit that stops unconverged ends at its best iteration since the last refinement, and
+/// while it pulls its worst points in no move throws others off: the bunny at Table 1 model C
+/// (Loop) stalled with E_max 0.43 %, one iteration after 0.047 %, when the heavy points of the
+/// pull dragged their neighbours off in a move the weighted objective accepted.
 #[test]
 fn a_fit_that_stalls_ends_at_its_best_iteration() {
     let path = common::data_file("stanford-bunny.obj");
@@ -111,9 +112,9 @@ fn a_fit_that_stalls_ends_at_its_best_iteration() {
         .iter()
         .map(|r| r.e_max_pct)
         .fold(0.0, f64::max);
+    assert!(report.e_max_pct <= worst_tail);
     assert!(
-        report.e_max_pct < worst_tail,
-        "{} {worst_tail}",
-        report.e_max_pct
+        worst_tail <= 2.0 * 0.05,
+        "E_max jumped to {worst_tail} % after the last refinement"
     );
 }
