@@ -165,6 +165,8 @@ pub struct IterationRecord {
 pub struct PhaseTimes {
     /// Working out the move: stencils and conjugate gradients (or the weighted error sums).
     pub moves_ms: f64,
+    /// Refilling the patch data for the moved control points (damping retries included).
+    pub refill_ms: f64,
     /// Foot points on the moved surface (Newton from the last ones), damping retries included.
     pub feet_ms: f64,
     /// The surface → data measure: evaluating samples and finding their nearest data.

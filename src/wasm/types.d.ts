@@ -132,6 +132,8 @@ export interface IterationRecord {
 export interface PhaseTimes {
   /** Stencils and conjugate gradients (or the weighted error sums). */
   moves_ms: number;
+  /** Refilling the patch data for the moved control points. */
+  refill_ms: number;
   /** Foot points on the moved surface, damping retries included. */
   feet_ms: number;
   /** The surface → data measure. */

@@ -491,7 +491,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
         };
         self.phases.add(|p| &mut p.moves_ms, started);
         let proposal = self.accel.propose(&old_points, &d);
-        self.surface.set_control_points(&proposal);
+        self.set_points(&proposal);
         self.update_feet(&old_feet);
         if !self.options.damping
             || (self.objective() <= old_objective * (1.0 + 1e-12) && !self.max_jumped(&old_stats))
@@ -505,16 +505,23 @@ impl<S: ControlSurface> SubdivFitter<S> {
                 .zip(&d)
                 .map(|(p, v)| *p + *v * t)
                 .collect();
-            self.surface.set_control_points(&damped);
+            self.set_points(&damped);
             self.update_feet(&old_feet);
             if self.objective() <= old_objective && !self.max_jumped(&old_stats) {
                 return true;
             }
         }
-        self.surface.set_control_points(&old_points);
+        self.set_points(&old_points);
         self.feet = old_feet;
         self.state.restore(old_signed, old_stats);
         false
+    }
+
+    /// Sets the control points (the surface refills its patch data), timed.
+    fn set_points(&mut self, points: &[Point3]) {
+        let started = Instant::now();
+        self.surface.set_control_points(points);
+        self.phases.add(|p| &mut p.refill_ms, started);
     }
 
     /// Whether E_max rose by more than [`MAX_JUMP`] from `before` past its tolerance while
