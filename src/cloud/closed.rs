@@ -29,7 +29,7 @@ impl Implicit<'_> {
         let nearest_sq = near.first().map_or(0.0, |n| n.1);
         for &(i, d2) in &near {
             // Weights relative to the nearest point, so they never all underflow far away.
-            let w = (-(d2 - nearest_sq) / (self.sigma * self.sigma)).exp();
+            let w = libm::exp(-(d2 - nearest_sq) / (self.sigma * self.sigma));
             num += w * (x - self.points[i]).dot(self.normals[i]);
             den += w;
         }

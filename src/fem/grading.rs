@@ -54,14 +54,14 @@ pub(super) fn elements_along(samples: &Samples, size: f64, grading: f64) -> f64 
 /// count at size L (not increasing in L): bisection on log L between `scale · 1e-9` and
 /// `scale · 10`, keeping the size whose count is nearest the target.
 pub(super) fn size_for_count(target: usize, scale: f64, count: impl Fn(f64) -> f64) -> f64 {
-    let (mut lo, mut hi) = ((scale * 1e-9).ln(), (scale * 10.0).ln());
+    let (mut lo, mut hi) = (libm::log(scale * 1e-9), libm::log(scale * 10.0));
     let goal = target as f64;
     let mut best = (f64::INFINITY, scale);
     for _ in 0..80 {
         let mid = 0.5 * (lo + hi);
-        let n = count(mid.exp());
+        let n = count(libm::exp(mid));
         if (n - goal).abs() < best.0 {
-            best = ((n - goal).abs(), mid.exp());
+            best = ((n - goal).abs(), libm::exp(mid));
         }
         if n > goal {
             lo = mid;

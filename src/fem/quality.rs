@@ -74,7 +74,7 @@ fn element(p: [Point3; 4], n: [Vec3; 4]) -> (f64, f64, f64) {
             0.0
         };
         jac = jac.min(if sj.is_finite() { sj } else { 0.0 });
-        let angle = c.length().atan2(a.dot(b)).to_degrees();
+        let angle = libm::atan2(c.length(), a.dot(b)).to_degrees();
         skew = skew.max(if angle.is_finite() {
             (90.0 - angle).abs()
         } else {

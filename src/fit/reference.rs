@@ -457,7 +457,7 @@ fn sagitta(corners: [Point3; 3], normals: [Vec3; 3]) -> f64 {
     for k in 0..3 {
         let j = (k + 1) % 3;
         h = h.max(corners[k].distance(corners[j]));
-        turn = turn.max(normals[k].dot(normals[j]).clamp(-1.0, 1.0).acos());
+        turn = turn.max(libm::acos(normals[k].dot(normals[j]).clamp(-1.0, 1.0)));
     }
     let s = h * turn.min(MAX_TURN) / 6.0;
     if s.is_finite() {

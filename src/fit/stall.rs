@@ -64,7 +64,7 @@ pub(crate) fn stalled(
             return true;
         }
         // Windows needed at this rate: ratio^k · now = tol.
-        let windows = (tol / now).ln() / ratio.ln();
+        let windows = libm::log(tol / now) / libm::log(ratio);
         windows * STALL_WINDOW as f64 > remaining as f64
     })
 }

@@ -159,7 +159,7 @@ pub fn detect_features(mesh: &PolyMesh, options: &FeatureOptions) -> Result<Feat
     for e in &edges {
         let (n1, n2) = (normals[e.faces[0] as usize], normals[e.faces[1] as usize]);
         let n2 = if e.agree { n2 } else { -n2 };
-        let angle = n1.dot(n2).clamp(-1.0, 1.0).acos();
+        let angle = libm::acos(n1.dot(n2).clamp(-1.0, 1.0));
         if angle > weak {
             candidates.push(e.ends);
             strong.push(angle > threshold);
@@ -237,7 +237,7 @@ fn filter_normals(
                     seen[j] = i as u32;
                     let dc = centroid[i].distance_squared(centroid[j]);
                     let dn = ni.distance_squared(normals[j]);
-                    sum += normals[j] * (area[j] * (-dc * inv_c - dn * inv_n).exp());
+                    sum += normals[j] * (area[j] * libm::exp(-dc * inv_c - dn * inv_n));
                 }
             }
             next[i] = sum.try_normalize().unwrap_or(ni);
@@ -599,7 +599,7 @@ fn mean_turn(positions: &[Point3], line: &FeatureLine) -> f64 {
         .filter_map(|i| {
             let d1 = (v[i] - v[i - stride]).try_normalize()?;
             let d2 = (v[i + stride] - v[i]).try_normalize()?;
-            Some(d1.dot(d2).clamp(-1.0, 1.0).acos())
+            Some(libm::acos(d1.dot(d2).clamp(-1.0, 1.0)))
         })
         .collect();
     if turns.is_empty() {

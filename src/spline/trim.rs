@@ -363,7 +363,7 @@ fn next_edge(
 ) -> Option<usize> {
     let outs = out_of.get_mut(&cur)?;
     let angle = |to: usize| {
-        let d = |a: [f64; 2], b: [f64; 2]| (b[1] - a[1]).atan2(b[0] - a[0]);
+        let d = |a: [f64; 2], b: [f64; 2]| libm::atan2(b[1] - a[1], b[0] - a[0]);
         let back = d(pos[cur], pos[prev]);
         (back - d(pos[cur], pos[to])).rem_euclid(std::f64::consts::TAU)
     };
@@ -475,12 +475,12 @@ fn douglas_peucker(p: &[[f64; 2]], a: usize, b: usize, tol: f64, keep: &mut [boo
     while let Some((a, b)) = stack.pop() {
         let (pa, pb) = (p[a], p[b]);
         let (dx, dy) = (pb[0] - pa[0], pb[1] - pa[1]);
-        let len = dx.hypot(dy);
+        let len = libm::hypot(dx, dy);
         let dist = |q: [f64; 2]| {
             if len > 0.0 {
                 ((q[0] - pa[0]) * dy - (q[1] - pa[1]) * dx).abs() / len
             } else {
-                (q[0] - pa[0]).hypot(q[1] - pa[1])
+                libm::hypot(q[0] - pa[0], q[1] - pa[1])
             }
         };
         let worst = (a + 1..b).max_by(|&i, &j| dist(p[i]).total_cmp(&dist(p[j])));

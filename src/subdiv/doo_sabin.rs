@@ -40,7 +40,7 @@ pub(crate) fn weight(n: usize, k: usize) -> f64 {
     if k == 0 {
         0.25 + 5.0 / (4.0 * nf)
     } else {
-        (3.0 + 2.0 * (2.0 * PI * k as f64 / nf).cos()) / (4.0 * nf)
+        (3.0 + 2.0 * libm::cos(2.0 * PI * k as f64 / nf)) / (4.0 * nf)
     }
 }
 

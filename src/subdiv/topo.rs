@@ -453,7 +453,7 @@ pub(crate) struct Refined {
 /// evaluation all use this one.
 pub(crate) fn loop_beta(n: usize) -> f64 {
     let n = n as f64;
-    let c = 0.375 + 0.25 * (2.0 * std::f64::consts::PI / n).cos();
+    let c = 0.375 + 0.25 * libm::cos(2.0 * std::f64::consts::PI / n);
     (0.625 - c * c) / n
 }
 

@@ -174,9 +174,9 @@ fn candidate_views(axes: [Vec3; 3]) -> Vec<Vec3> {
     for tilt in [15.0f64, 30.0] {
         for k in 0..8 {
             let az = (k as f64 * 45.0).to_radians();
-            let side = axes[0] * az.cos() + axes[1] * az.sin();
+            let side = axes[0] * libm::cos(az) + axes[1] * libm::sin(az);
             let t = tilt.to_radians();
-            views.push((axes[2] * t.cos() + side * t.sin()).normalize());
+            views.push((axes[2] * libm::cos(t) + side * libm::sin(t)).normalize());
         }
     }
     views
@@ -413,7 +413,7 @@ fn min_area_axes(points: &[Point3], center: Point3, a: Vec3, b: Vec3) -> (Vec3, 
         .map(|p| ((*p - center).dot(a), (*p - center).dot(b)))
         .collect();
     let area = |deg: usize| {
-        let (s, c) = (deg as f64).to_radians().sin_cos();
+        let (s, c) = libm::sincos((deg as f64).to_radians());
         let (lo_u, hi_u) = extent(flat.iter().map(|&(x, y)| c * x + s * y));
         let (lo_v, hi_v) = extent(flat.iter().map(|&(x, y)| -s * x + c * y));
         (hi_u - lo_u) * (hi_v - lo_v)
@@ -427,7 +427,7 @@ fn min_area_axes(points: &[Point3], center: Point3, a: Vec3, b: Vec3) -> (Vec3, 
         .map(|d| d % 90)
         .min_by(|&i, &j| area(i).total_cmp(&area(j)))
         .unwrap_or(coarse);
-    let (s, c) = (best as f64).to_radians().sin_cos();
+    let (s, c) = libm::sincos((best as f64).to_radians());
     (a * c + b * s, b * c - a * s)
 }
 

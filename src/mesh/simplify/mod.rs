@@ -156,7 +156,7 @@ impl SimplifyOptions {
     /// The limits of the configured options, then the relaxed ones, loosest last.
     fn stages(&self) -> Vec<Limits> {
         let first = Limits {
-            min_normal_cos: self.max_normal_change_deg.to_radians().cos(),
+            min_normal_cos: libm::cos(self.max_normal_change_deg.to_radians()),
             min_quality: self.min_triangle_quality,
             max_valence: self.max_valence,
             min_reference_cos: REFERENCE_COS,
@@ -164,7 +164,7 @@ impl SimplifyOptions {
         let mut stages = vec![first];
         for (degrees, quality) in RELAXED {
             let next = Limits {
-                min_normal_cos: first.min_normal_cos.min(f64::to_radians(degrees).cos()),
+                min_normal_cos: first.min_normal_cos.min(libm::cos(degrees.to_radians())),
                 min_quality: first.min_quality.min(quality),
                 min_reference_cos: 0.0,
                 ..first
@@ -440,7 +440,7 @@ fn reduce(engine: &mut Engine, target: usize, stages: &[Limits]) -> (usize, Vec<
         };
         relaxations.push(Relaxation {
             at_vertices: engine.live(),
-            max_normal_change_deg: limits.min_normal_cos.clamp(-1.0, 1.0).acos().to_degrees(),
+            max_normal_change_deg: libm::acos(limits.min_normal_cos.clamp(-1.0, 1.0)).to_degrees(),
             min_triangle_quality: limits.min_quality,
         });
     }

@@ -349,7 +349,7 @@ fn flip_keeps_shape(pos: &[Point3], old: [[u32; 3]; 2], new: [[u32; 3]; 2]) -> b
         return false;
     };
     let avg = (n1 + n2).normalize_or_zero();
-    n1.dot(n2) > 30f64.to_radians().cos() && m1.dot(avg) > 0.5 && m2.dot(avg) > 0.5
+    n1.dot(n2) > libm::cos(30f64.to_radians()) && m1.dot(avg) > 0.5 && m2.dot(avg) > 0.5
 }
 
 #[cfg(test)]
