@@ -113,6 +113,14 @@ fn a_fit_that_stalls_ends_at_its_best_iteration() {
         .map(|r| r.e_max_pct)
         .fold(0.0, f64::max);
     assert!(report.e_max_pct <= worst_tail);
+    // The fit's time is its records' time, the closing work (going back, the dense measure)
+    // included in the last one.
+    let ms: f64 = history.iter().map(|r| r.ms).sum();
+    assert!(
+        (report.fit_s * 1e3 - ms).abs() <= 1e-6 * ms,
+        "{} {ms}",
+        report.fit_s
+    );
     assert!(
         worst_tail <= 2.0 * 0.05,
         "E_max jumped to {worst_tail} % after the last refinement"

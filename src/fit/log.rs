@@ -87,6 +87,19 @@ impl FitLog {
         }
     }
 
+    /// Adds `seconds` spent closing the fit after its last record (going back to the best
+    /// iteration, the final dense measure) to that record, as surface → data time, and to the
+    /// fit's time: a report's `total_s` is what the user waited.
+    pub(crate) fn amend_time(&mut self, seconds: f64) {
+        self.fit_s += seconds;
+        if let Some(last) = self.history.last_mut() {
+            last.ms += seconds * 1e3;
+            if let Some(p) = last.phases.as_mut() {
+                p.back_ms += seconds * 1e3;
+            }
+        }
+    }
+
     /// Sets where the last iteration's time went.
     pub(crate) fn set_phases(&mut self, phases: super::PhaseTimes) {
         if let Some(last) = self.history.last_mut() {

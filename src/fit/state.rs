@@ -205,6 +205,11 @@ impl FitState {
         self.log.amend_back(self.back);
     }
 
+    /// Adds the time since `start` to the last iteration's record and the fit's time.
+    pub(crate) fn amend_time(&mut self, start: Instant) {
+        self.log.amend_time(start.elapsed().as_secs_f64());
+    }
+
     /// Writes the current data → surface statistics into the last iteration's record.
     pub(crate) fn amend_stats(&mut self) {
         self.log.amend_stats(&self.stats);

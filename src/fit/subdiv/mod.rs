@@ -1103,6 +1103,7 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
         if status == FitStatus::Running && self.is_stalled() {
             status = self.state.log_mut().stop(FitStatus::Stalled);
         }
+        let closing = Instant::now();
         if matches!(status, FitStatus::Stalled | FitStatus::MaxIterations) && self.go_back_to_best()
         {
             self.back_dense = false;
@@ -1112,6 +1113,9 @@ impl<S: ControlSurface> Fitter for SubdivFitter<S> {
             // A fit ends with the dense figure, converged or not.
             self.measure_back_densely();
             self.state.amend_back();
+        }
+        if status != FitStatus::Running {
+            self.state.amend_time(closing);
         }
         Ok(status)
     }
