@@ -163,7 +163,7 @@ pub struct DataSurface {
     /// ...their positions (relative to the origin) and, per vertex, its triangles (CSR: those
     /// of vertex v are `incident[first[v]..first[v + 1]]`), with each triangle's corners.
     positions: Vec<[f32; 3]>,
-    first: Vec<u32>,
+    first: Vec<usize>,
     incident: Vec<u32>,
     triangles: Vec<[u32; 3]>,
     /// The boundary edges (none on a closed mesh).
@@ -265,7 +265,7 @@ impl DataSurface {
                 near.last().map_or(0.0, |n| n.distance.sqrt())
             })
             .collect();
-        let (first, incident) = incident_triangles(positions.len(), &triangles);
+        let (first, incident) = crate::mesh::vertex_faces(positions.len(), &triangles);
         Some(DataSurface {
             origin,
             tree: RTree::bulk_load(objects),
@@ -425,7 +425,7 @@ impl DataSurface {
         let v = self.vertices.nearest_one::<SquaredEuclidean>(&q).item as usize;
         let around = self
             .incident
-            .get(*self.first.get(v)? as usize..*self.first.get(v + 1)? as usize)?;
+            .get(*self.first.get(v)?..*self.first.get(v + 1)?)?;
         let corner = |i: u32| {
             let [x, y, z] = self.positions[i as usize];
             Point3::new(x as f64, y as f64, z as f64)
@@ -533,29 +533,6 @@ fn closest_on_triangle(p: Point3, a: Point3, b: Point3, c: Point3) -> (Point3, F
     }
     let (v, w) = (vb / denom, vc / denom);
     (a + ab * v + ac * w, Feature::Face)
-}
-
-/// The triangles of each of `vertices` vertices, compressed: those of vertex v are
-/// `incident[first[v]..first[v + 1]]`, in the order of `triangles`.
-fn incident_triangles(vertices: usize, triangles: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
-    let mut first = vec![0u32; vertices + 1];
-    for t in triangles {
-        for &v in t {
-            first[v as usize + 1] += 1;
-        }
-    }
-    for v in 0..vertices {
-        first[v + 1] += first[v];
-    }
-    let mut fill = first.clone();
-    let mut incident = vec![0u32; first[vertices] as usize];
-    for (i, t) in triangles.iter().enumerate() {
-        for &v in t {
-            incident[fill[v as usize] as usize] = i as u32;
-            fill[v as usize] += 1;
-        }
-    }
-    (first, incident)
 }
 
 /// Per triangle, the bit mask of its edges that no other triangle shares.

@@ -249,7 +249,7 @@ fn filter_normals(
 }
 
 /// The faces of every vertex, as a compressed list: `faces[starts[v]..starts[v + 1]]`.
-fn vertex_faces(num_vertices: usize, triangles: &[[u32; 3]]) -> (Vec<usize>, Vec<u32>) {
+pub(crate) fn vertex_faces(num_vertices: usize, triangles: &[[u32; 3]]) -> (Vec<usize>, Vec<u32>) {
     let mut starts = vec![0usize; num_vertices + 1];
     for t in triangles {
         for &v in t {
