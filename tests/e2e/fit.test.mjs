@@ -615,17 +615,21 @@ for (const backend of BACKENDS) describe(`fitting page, ${backend.name}`, () => 
       await fresh.click('#fit-play');
       await fresh.waitForSelector('body[data-fit="running"]', { timeout: TIMEOUT_MS });
       assert.equal(await fresh.isHidden('#fit-cancel'), false);
-      // The progress line names the set-up's phase and how far it is.
-      await fresh.waitForFunction(() => /^Meshing the points: \d+ %$/.test(document.getElementById('fit-phase').textContent), null, { timeout: TIMEOUT_MS });
+      // The progress line names the set-up's phase and how far it is. Polled on a timer, not on
+      // animation frames: a frame of 250,000 points on SwiftShader can take longer than the
+      // meshing phase lasts, and a missed phase would be waited for to the timeout.
+      await fresh.waitForFunction(() => window.geofitFit.phases.some((p) => p.phase === 'reconstruction'), null, { timeout: TIMEOUT_MS, polling: 50 });
       assert.equal(await fresh.isHidden('#fit-progress-row'), false);
-      const [state, ms, framed] = await fresh.evaluate(() => {
+      const [state, ms, framed, line] = await fresh.evaluate(() => {
         const framed = window.geofitFit.lastStats !== null;
+        const line = document.getElementById('fit-phase').textContent;
         const t0 = performance.now();
         document.getElementById('fit-cancel').click();
-        return [document.body.dataset.fit, performance.now() - t0, framed];
+        return [document.body.dataset.fit, performance.now() - t0, framed, line];
       });
-      console.log(`[e2e] ${backend.name} cancel of 500K points (set-up done: ${framed}): ${state} after ${ms.toFixed(1)} ms`);
+      console.log(`[e2e] ${backend.name} cancel of 500K points (set-up done: ${framed}, at "${line}"): ${state} after ${ms.toFixed(1)} ms`);
       assert.equal(framed, false, 'cancelled during the set-up');
+      assert.match(line, /^(Meshing the points|Repairing the mesh|Simplifying \(QEM\)|Setting up the fit): \d+ %$/);
       assert.equal(state, 'cancelled');
       assert.ok(ms < 200, `${ms} ms`);
       assert.equal(await fresh.isHidden('#fit-cancel'), true);
