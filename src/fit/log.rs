@@ -213,6 +213,13 @@ impl FitLog {
     pub fn intake_notes(&self) -> Vec<String> {
         let mut notes: Vec<String> = self.strays.iter().map(StrayPoints::note).collect();
         if let Some(r) = &self.reconstruction {
+            if let Some(left) = r.open_uncovered {
+                notes.push(format!(
+                    "the points look like an open scan, but its triangulation in projection \
+                     left {left} of them in no triangle (no height field): meshed as a closed \
+                     surface instead"
+                ));
+            }
             notes.push(format!(
                 "reconstructed {} surface ({}): {} triangles, {} outliers removed",
                 r.kind, r.method, r.triangles, r.outliers

@@ -208,6 +208,9 @@ export interface ReconstructionReport {
   triangles: number;
   /** Closed objects: triangles of the implicit surface dropped where no point was near. */
   stray_triangles: number;
+  /** Points taken for an open scan that its triangulation in projection left in no triangle
+   * (too many), so they were reconstructed as a closed object instead. */
+  open_uncovered?: number;
   seconds: number;
 }
 

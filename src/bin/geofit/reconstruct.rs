@@ -65,6 +65,7 @@ pub fn run(args: Args) -> Result<(), String> {
         "vertices": result.mesh.num_vertices(),
         "triangles": result.mesh.num_triangles(),
         "stray_triangles": result.stray_triangles,
+        "open_uncovered": result.open_uncovered,
         "reconstruct_s": seconds,
         "deviation_max_pct": dev.map(|d| d.max),
         "deviation_rms_pct": dev.map(|d| d.rms),

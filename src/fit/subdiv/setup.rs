@@ -179,6 +179,11 @@ pub struct ReconstructionReport {
     /// Closed objects: triangles of the implicit surface dropped because they strayed from
     /// the points (the mesh has holes there; see [`crate::cloud`]).
     pub stray_triangles: usize,
+    /// Points taken for an open scan that a triangulation in projection left in no triangle
+    /// (too many: they are no height field), so they were reconstructed as a closed object;
+    /// absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub open_uncovered: Option<usize>,
     /// Seconds the reconstruction took (included in the report's `precompute_s`).
     pub seconds: f64,
 }
@@ -289,6 +294,7 @@ fn reconstruct_cloud(
         vertices: used_vertices(&rec.mesh),
         triangles: rec.mesh.num_triangles(),
         stray_triangles: rec.stray_triangles,
+        open_uncovered: rec.open_uncovered,
         seconds: start.elapsed().as_secs_f64(),
     };
     Ok((kept, rec.mesh, report))
