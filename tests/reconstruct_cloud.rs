@@ -45,7 +45,11 @@ fn range_scan_by_grid_and_by_delaunay() {
             points.len(),
             boundary_loops(&r.mesh)
         );
-        assert!(used as f64 > 0.9 * points.len() as f64, "{name}: {used}");
+        // Every piece of the scan stays (by the grid, the near ear and a front foot are cut
+        // off by depth jumps; only 174 grazing samples are left out), so the fit has no data
+        // to pull webs out to.
+        let share = if name == "grid" { 0.99 } else { 0.9 };
+        assert!(used as f64 > share * points.len() as f64, "{name}: {used}");
         let coarse = simplify(&r.mesh, 400).unwrap();
         assert_manifold(&coarse);
     }
