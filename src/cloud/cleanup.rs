@@ -1,5 +1,5 @@
 //! Turning a triangle list into a manifold surface the fitter accepts: no edge with more than
-//! two faces, consistent orientation, every vertex a single fan, no specks.
+//! two faces, consistent orientation, every vertex a single fan, one piece (an open scan: its pieces).
 
 /// Tiny union–find over `n` items.
 struct Sets(Vec<u32>);
@@ -26,9 +26,12 @@ impl Sets {
 /// The manifold part of `tris` over `vertex_count` vertices: degenerate and duplicate faces
 /// dropped, then faces that overload an edge, contradict its orientation or hang off a vertex
 /// as a second fan (the larger fan stays), repeated until none is left; finally the
-/// connected pieces too small to be a part of the surface are left out
-/// ([`substantial_pieces`]).
-pub(super) fn manifold_part(tris: Vec<[u32; 3]>, vertex_count: usize) -> Vec<[u32; 3]> {
+/// connected `pieces` that stay.
+pub(super) fn manifold_part(
+    tris: Vec<[u32; 3]>,
+    vertex_count: usize,
+    pieces: Pieces,
+) -> Vec<[u32; 3]> {
     let mut seen = std::collections::HashSet::new();
     let mut tris: Vec<[u32; 3]> = tris
         .into_iter()
@@ -51,7 +54,24 @@ pub(super) fn manifold_part(tris: Vec<[u32; 3]>, vertex_count: usize) -> Vec<[u3
             .filter_map(|(t, k)| k.then_some(t))
             .collect();
     }
-    substantial_pieces(tris)
+    let least = |largest: usize| match pieces {
+        Pieces::Largest => largest,
+        Pieces::Substantial => (largest / PIECE_SHARE).max(MIN_PIECE_FACES).min(largest),
+    };
+    pieces_of_at_least(tris, least)
+}
+
+/// Which connected pieces of a triangulation stay.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Pieces {
+    /// The largest only: an implicit surface's other pieces are fragments of its contour
+    /// around thin parts. Kept with the bare vertices of the corpus's closed meshes, they made
+    /// the fitted surface stray farther from the mesh the points came from (homer: 1.34 →
+    /// 1.61 % with Loop, 1.76 → 2.38 % with Catmull–Clark; cow 2.04 → 3.22 %).
+    Largest,
+    /// Every piece of at least 1/[`PIECE_SHARE`] of the largest piece's faces and at least
+    /// [`MIN_PIECE_FACES`]: the parts of an open scan that depth jumps cut apart.
+    Substantial,
 }
 
 /// Faces to keep so that no undirected edge has more than two faces and no directed edge
@@ -130,9 +150,9 @@ fn fan_keep(tris: &[[u32; 3]], mut keep: Vec<bool>, vertex_count: usize) -> Vec<
     keep
 }
 
-/// The faces of the edge-connected pieces of at least [`MIN_PIECE_FACES`] faces and
-/// 1/[`PIECE_SHARE`] of the largest piece's, in their order.
-fn substantial_pieces(tris: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
+/// The faces of the edge-connected pieces of at least `least(faces of the largest piece)`
+/// faces, in their order.
+fn pieces_of_at_least(tris: Vec<[u32; 3]>, least: impl Fn(usize) -> usize) -> Vec<[u32; 3]> {
     let mut edges: Vec<(u32, u32, u32)> = Vec::with_capacity(3 * tris.len());
     for (f, t) in tris.iter().enumerate() {
         for k in 0..3 {
@@ -153,21 +173,21 @@ fn substantial_pieces(tris: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
         sizes[r as usize] += 1;
     }
     let largest = sizes.iter().copied().max().unwrap_or(0);
-    let least = (largest / PIECE_SHARE).max(MIN_PIECE_FACES).min(largest);
+    let least = least(largest);
     tris.into_iter()
         .zip(roots)
         .filter_map(|(t, r)| (sizes[r as usize] >= least).then_some(t))
         .collect()
 }
 
-/// A piece with fewer than 1/this of the largest piece's faces is left out (its points stay
-/// data, in no triangle). The pieces are real parts of the scan: on bun000.ply the near ear
-/// (1,608 triangles) and a front foot (666) are cut off from the head and body by the depth
-/// jumps around them, and a fit that had only the largest piece pulled webs from the head out
-/// to them (E_back 5.5–5.9 %; with the pieces 1.5–1.9 %). Measured on bun000 and the bare
-/// vertices of every mesh of ../shared/data and corpus/: keeping pieces of 0.5 % and 20 faces
-/// or more left bun000 at E_back 2.4–2.8 %, this at 1.5–1.9 %, and changed nothing else for
-/// the worse (docs/clouds.md).
+/// An open scan's piece with fewer than 1/this of the largest piece's faces is left out (its
+/// points stay data, in no triangle). The pieces are real parts of the scan: on bun000.ply the
+/// near ear (1,608 triangles) and a front foot (666) are cut off from the head and body by the
+/// depth jumps around them, and a fit that had only the largest piece pulled webs from the head
+/// out to them: its surface came up to 4.5 % of the diagonal from the Stanford bunny's own
+/// mesh (which is in the scan's frame), and with the pieces within 0.96 % (Loop; docs/clouds.md).
+/// Pieces of 0.5 % and 20 faces or more instead left bun000 at E_back 2.4–2.8 %, this at
+/// 1.5–1.9 %.
 const PIECE_SHARE: usize = 1000;
 /// Pieces of fewer faces than this are specks of scanner noise and are left out.
 const MIN_PIECE_FACES: usize = 8;
@@ -194,21 +214,31 @@ mod tests {
         let part = strip(10_000, 4);
         let speck = strip(20_000, 3);
         let tris: Vec<[u32; 3]> = [large.clone(), part.clone(), speck].concat();
-        let kept = manifold_part(tris, 30_000);
+        let kept = manifold_part(tris.clone(), 30_000, Pieces::Substantial);
+        assert_eq!(manifold_part(tris, 30_000, Pieces::Largest), large);
         assert_eq!(kept, [large.clone(), part].concat());
         // A piece below 1/1000 of the largest goes however many faces it has.
         let huge = strip(0, 5000);
         let small = strip(20_000, 4);
-        assert_eq!(manifold_part([huge.clone(), small].concat(), 30_000), huge);
+        assert_eq!(
+            manifold_part([huge.clone(), small].concat(), 30_000, Pieces::Substantial),
+            huge
+        );
     }
 
     #[test]
     fn bowtie_keeps_the_larger_fan_and_islands_go() {
         // Two fans meeting at vertex 0: {0,1,2},{0,2,3} and {0,4,5}; plus an island 6-7-8.
         let tris = vec![[0, 1, 2], [0, 2, 3], [0, 4, 5], [6, 7, 8]];
-        assert_eq!(manifold_part(tris, 9), vec![[0, 1, 2], [0, 2, 3]]);
+        assert_eq!(
+            manifold_part(tris, 9, Pieces::Largest),
+            vec![[0, 1, 2], [0, 2, 3]]
+        );
         // A third face on edge 0-1 and a flipped duplicate go.
         let tris = vec![[0, 1, 2], [1, 0, 3], [0, 1, 4], [2, 1, 0]];
-        assert_eq!(manifold_part(tris, 5), vec![[0, 1, 2], [1, 0, 3]]);
+        assert_eq!(
+            manifold_part(tris, 5, Pieces::Largest),
+            vec![[0, 1, 2], [1, 0, 3]]
+        );
     }
 }
