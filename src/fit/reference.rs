@@ -26,6 +26,15 @@ use std::collections::HashMap;
 /// a hole can come nearer to the data beyond the rim than to the rim itself, but not by much.
 pub const RIM_FACTOR: f64 = 2.0;
 
+/// Bare points: a sample within this many disc radii of its nearest point (a radius is the
+/// distance to the point's 4th neighbour, about two point spacings) is measured whatever the
+/// reconstruction's boundary says: a gap that narrow lies between neighbouring points, not over
+/// a hole. Without it, homer's vertices as bare points fitted with Doo–Sabin "converged" at
+/// E_back 0.94 % with a sheet 2.7 % from homer's mesh, 2.85 % from the nearest point where the
+/// points are 1.1–1.5 % apart, over a hole that dropping the implicit surface's strays had
+/// opened in the closed object's reconstruction.
+pub const HOLE_RADII: f64 = 3.0;
+
 /// How far from its nearest vertex's triangles, in their longest edges, a query may lie and
 /// still start from them ([`DataSurface::seed_bound`]): farther, the box that bound spans holds
 /// many triangles, and the R-tree's best-first search finds the nearest sooner.
@@ -331,15 +340,20 @@ impl DataSurface {
         if let Some((d, at)) = loose.filter(|(d, _)| d * d < foot.dist_sq) {
             return Some((d, at + self.origin));
         }
-        if foot.on_boundary {
-            return None;
-        }
-        let near_rim = self
-            .rim
-            .locate_within_distance(p.to_array(), RIM_FACTOR * RIM_FACTOR * foot.dist_sq)
-            .next()
-            .is_some();
-        if near_rim {
+        // Bare points: near a point (a few disc radii) is no hole, whatever the
+        // reconstruction's boundary says there (an implicit surface's dropped strays open
+        // holes in closed objects where the points are sparse).
+        let sampled = self
+            .surfels
+            .as_ref()
+            .is_some_and(|s| s.within_radii(p, HOLE_RADII));
+        let near_rim = || {
+            self.rim
+                .locate_within_distance(p.to_array(), RIM_FACTOR * RIM_FACTOR * foot.dist_sq)
+                .next()
+                .is_some()
+        };
+        if !sampled && (foot.on_boundary || near_rim()) {
             return None;
         }
         if let Some(surfels) = &self.surfels {

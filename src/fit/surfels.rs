@@ -83,6 +83,20 @@ impl Surfels {
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
 
+    /// Whether `p` (relative to the origin) lies within `radii` disc radii of its nearest
+    /// point: there the points are dense enough to say where the surface is, so no hole of
+    /// the data can be there, only a gap between neighbouring points.
+    pub(super) fn within_radii(&self, p: Point3, radii: f64) -> bool {
+        if self.centres.is_empty() {
+            return false;
+        }
+        let n = self
+            .tree
+            .nearest_one::<SquaredEuclidean>(&p.as_vec3().to_array());
+        let r = self.radii.get(n.item as usize).copied().unwrap_or(0.0) as f64;
+        (n.distance as f64).sqrt() <= radii * r
+    }
+
     /// The distance from `p` to disc `i` and the disc's point nearest to `p`.
     fn to_disc(&self, i: usize, p: Point3) -> (f64, Point3) {
         let c = at(&self.centres, i as u32);
