@@ -19,8 +19,17 @@ pub(crate) struct Fairness {
 }
 
 impl Fairness {
-    /// The neighbours (edge-connected vertices) of every control point of `control`.
-    pub(crate) fn of(control: &PolyMesh) -> Fairness {
+    /// The neighbours (edge-connected vertices) of every control point of `control`, with its
+    /// crease edges `creases` (vertex pairs) taken as the subdivision rules take them: a
+    /// vertex on a crease line (two crease edges) is smoothed along the line only, and a
+    /// corner (three or more) not at all.
+    ///
+    /// Why: the umbrella of a vertex on a crease averages the two faces that meet there, so
+    /// its mean lies off the surface, inside the fold; on fandisk (Catmull–Clark with
+    /// creases, E_max 0.05 %) that pull dragged the crease vertices of a thin wall's rim
+    /// down, and the control points of the flat top beside them rose to make up for it: a
+    /// bump 1 % of the diagonal above the top face after one move.
+    pub(crate) fn of(control: &PolyMesh, creases: &[[u32; 2]]) -> Fairness {
         let n = control.num_vertices();
         let mut pairs: Vec<(u32, u32)> = Vec::new();
         for f in control.faces() {
@@ -30,6 +39,23 @@ impl Fairness {
                 pairs.push((b, a));
             }
         }
+        let mut along: Vec<(u32, u32)> = creases
+            .iter()
+            .filter(|[a, b]| (*a as usize) < n && (*b as usize) < n && a != b)
+            .flat_map(|&[a, b]| [(a, b), (b, a)])
+            .collect();
+        along.sort_unstable();
+        along.dedup();
+        let mut crease_degree = vec![0usize; n];
+        for &(a, _) in &along {
+            crease_degree[a as usize] += 1;
+        }
+        pairs.retain(|&(a, _)| crease_degree[a as usize] < 2);
+        pairs.extend(
+            along
+                .into_iter()
+                .filter(|&(a, _)| crease_degree[a as usize] == 2),
+        );
         pairs.sort_unstable();
         pairs.dedup();
         let mut starts = vec![0usize; n + 1];

@@ -449,6 +449,16 @@ impl<S: ControlSurface> SubdivFitter<S> {
             .unzip()
     }
 
+    /// The control mesh's crease edges (none for a surface that is no [`SubdivSurface`]).
+    ///
+    /// [`SubdivSurface`]: crate::subdiv::SubdivSurface
+    fn creases(&self) -> Vec<[u32; 2]> {
+        self.surface
+            .as_subdiv()
+            .map(|s| s.control_mesh().creases())
+            .unwrap_or_default()
+    }
+
     /// One move of the control points with damping: a move that raises the weighted squared
     /// error ([`SubdivFitter::objective`]) is halved (twice at most) and otherwise undone.
     /// Returns whether a move was kept.
@@ -476,7 +486,7 @@ impl<S: ControlSurface> SubdivFitter<S> {
                     .fairness
                     .iter()
                     .any(|&w| w > 0.0)
-                    .then(|| Fairness::of(&self.surface.control_polygons()));
+                    .then(|| Fairness::of(&self.surface.control_polygons(), &self.creases()));
                 let fair = fairness
                     .as_ref()
                     .map(|f| (f, old_points.as_slice(), self.fairness.as_slice()));
