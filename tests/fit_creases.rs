@@ -13,6 +13,12 @@ use geofit::subdiv::adaptive::{carried_creases, refine_marked, tag_creases};
 use geofit::subdiv::Scheme as Subdiv;
 use std::collections::HashMap;
 
+/// fandisk.obj from ../shared/data, repaired as every fit's intake repairs it.
+fn fandisk() -> PolyMesh {
+    let file = geofit::io::read_path(&data_file("fandisk.obj")).expect("fandisk.obj");
+    repair(&file.mesh).expect("repair").mesh
+}
+
 /// Unit cubes for the tagged-refinement tests: finely triangulated for Loop, six quads for
 /// Catmull–Clark.
 fn cubes() -> [(Subdiv, PolyMesh); 2] {
@@ -141,8 +147,7 @@ fn fit(mesh: &PolyMesh, scheme: Scheme, creases: bool) -> (FitReport, PolyMesh) 
 
 #[test]
 fn fandisk_keeps_its_creases_sharp_through_the_fit() {
-    let file = geofit::io::read_path(&data_file("fandisk.obj")).expect("fandisk.obj");
-    let mesh = repair(&file.mesh).expect("repair").mesh;
+    let mesh = fandisk();
     let features = detect_features(&mesh, &FeatureOptions::default()).expect("features");
     let diagonal = mesh.bbox().expect("bbox").diagonal();
     for scheme in [Scheme::Loop, Scheme::CatmullClark] {
@@ -236,8 +241,7 @@ fn rocker_arm_converges_with_fewer_control_points_when_its_creases_are_kept() {
 /// iteration, nothing refined).
 #[test]
 fn a_move_does_not_lift_the_surface_off_the_data_beside_a_crease() {
-    let file = geofit::io::read_path(&data_file("fandisk.obj")).expect("fandisk.obj");
-    let mesh = repair(&file.mesh).expect("repair").mesh;
+    let mesh = fandisk();
     let spec = FitSpec::new(Scheme::CatmullClark)
         .with_creases(true)
         .with_refine(false)
@@ -267,8 +271,7 @@ fn a_move_does_not_lift_the_surface_off_the_data_beside_a_crease() {
 
 #[test]
 fn a_fit_refining_by_a_handful_of_points_without_progress_stalls() {
-    let file = geofit::io::read_path(&data_file("fandisk.obj")).expect("fandisk.obj");
-    let mesh = repair(&file.mesh).expect("repair").mesh;
+    let mesh = fandisk();
     let spec = FitSpec::new(Scheme::Loop)
         .with_creases(true)
         .with_tol_avg(Some(0.01))

@@ -343,10 +343,11 @@ impl DataSurface {
         // Bare points: near a point (a few disc radii) is no hole, whatever the
         // reconstruction's boundary says there (an implicit surface's dropped strays open
         // holes in closed objects where the points are sparse).
-        let sampled = self
+        let near = self
             .surfels
             .as_ref()
-            .is_some_and(|s| s.within_radii(p, HOLE_RADII));
+            .and_then(|s| s.closest_within(p, HOLE_RADII));
+        let sampled = near.is_some_and(|(_, _, within)| within);
         let near_rim = || {
             self.rim
                 .locate_within_distance(p.to_array(), RIM_FACTOR * RIM_FACTOR * foot.dist_sq)
@@ -356,8 +357,8 @@ impl DataSurface {
         if !sampled && (foot.on_boundary || near_rim()) {
             return None;
         }
-        if let Some(surfels) = &self.surfels {
-            return surfels.closest(p).map(|(d, at)| (d, at + self.origin));
+        if self.surfels.is_some() {
+            return near.map(|(d, at, _)| (d, at + self.origin));
         }
         Some((
             (foot.dist_sq.sqrt() - foot.sagitta).max(0.0),

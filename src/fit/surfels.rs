@@ -83,18 +83,27 @@ impl Surfels {
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
 
-    /// Whether `p` (relative to the origin) lies within `radii` disc radii of its nearest
-    /// point: there the points are dense enough to say where the surface is, so no hole of
-    /// the data can be there, only a gap between neighbouring points.
-    pub(super) fn within_radii(&self, p: Point3, radii: f64) -> bool {
-        if self.centres.is_empty() {
-            return false;
-        }
-        let n = self
+    /// [`Surfels::closest`], and whether `p` lies within `radii` disc radii of its nearest
+    /// point, from one search: there the points are dense enough to say where the surface
+    /// is, so no hole of the data can be there, only a gap between neighbouring points.
+    pub(super) fn closest_within(&self, p: Point3, radii: f64) -> Option<(f64, Point3, bool)> {
+        let k = NonZero::new(QUERY_NEIGHBOURS.min(self.centres.len()))?;
+        let near = self
             .tree
-            .nearest_one::<SquaredEuclidean>(&p.as_vec3().to_array());
-        let r = self.radii.get(n.item as usize).copied().unwrap_or(0.0) as f64;
-        (n.distance as f64).sqrt() <= radii * r
+            .nearest_n::<SquaredEuclidean>(&p.as_vec3().to_array(), k);
+        let nearest = near
+            .iter()
+            .min_by(|a, b| a.distance.total_cmp(&b.distance))?;
+        let r = self
+            .radii
+            .get(nearest.item as usize)
+            .copied()
+            .unwrap_or(0.0) as f64;
+        let within = (nearest.distance as f64).sqrt() <= radii * r;
+        near.iter()
+            .map(|n| self.to_disc(n.item as usize, p))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map(|(d, at)| (d, at, within))
     }
 
     /// The distance from `p` to disc `i` and the disc's point nearest to `p`.
