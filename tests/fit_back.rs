@@ -62,24 +62,10 @@ fn a_converged_fit_lies_on_the_data_at_every_tessellation_vertex() {
     }
 }
 
-/// A fit that stops unconverged ends at its best iteration since the last refinement, and
-/// while it pulls its worst points in no move throws others off: the bunny at Table 1 model C
-/// (Loop) stalled with E_max 0.43 %, one iteration after 0.047 %, when the heavy points of the
-/// pull dragged their neighbours off in a move the weighted objective accepted.
-#[test]
-fn a_fit_that_stalls_ends_at_its_best_iteration() {
-    let path = common::data_file("stanford-bunny.obj");
-    if !path.exists() {
-        eprintln!("skipped: no {}", path.display());
-        return;
-    }
-    let mesh = read_path(&path).expect("the file reads").mesh;
-    let mut spec = FitSpec::new(Scheme::Loop);
-    (spec.initial, spec.tol_avg, spec.tol_max) = (Some(612), Some(0.01), Some(0.05));
-    (spec.max_control, spec.max_iter) = (Some(7049), Some(60));
-    let mut fit = spec.build(&FitData::points(&mesh)).expect("the fit starts");
-    fit.run().expect("the fit runs");
-    let report = FitReport::of(fit.as_ref());
+/// Checks that a fit which stopped unconverged past its best iteration since the last
+/// refinement ended there: the report's figures are that iteration's (foot points found again
+/// give the same), the last record is the state it ends in, and the fit's time is its records'.
+fn assert_ends_at_best(report: &FitReport) {
     let k = report
         .ended_at_iteration
         .expect("this fit is known to stop past its best iteration");
@@ -94,7 +80,6 @@ fn a_fit_that_stalls_ends_at_its_best_iteration() {
         k >= last_refined && k < report.iterations,
         "{k} {last_refined}"
     );
-    // The same control points give the same figures (foot points found again).
     let best = &history[k - 1];
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-3 * b;
     assert!(
@@ -104,7 +89,6 @@ fn a_fit_that_stalls_ends_at_its_best_iteration() {
         best.e_max_pct
     );
     assert!(close(report.e_avg_pct, best.e_avg_pct));
-    // The last record is the state the fit ends in, and no worse on E_max than its best.
     let last = history.last().expect("iterations ran");
     assert_eq!(last.e_max_pct, report.e_max_pct);
     assert_eq!(last.e_back_max_pct, report.e_back_max_pct);
@@ -113,18 +97,76 @@ fn a_fit_that_stalls_ends_at_its_best_iteration() {
         .map(|r| r.e_max_pct)
         .fold(0.0, f64::max);
     assert!(report.e_max_pct <= worst_tail);
-    // The fit's time is its records' time, the closing work (going back, the dense measure)
-    // included in the last one.
+    // The closing work (going back, the dense measure) is in the last record's time.
     let ms: f64 = history.iter().map(|r| r.ms).sum();
     assert!(
         (report.fit_s * 1e3 - ms).abs() <= 1e-6 * ms,
         "{} {ms}",
         report.fit_s
     );
-    assert!(
-        worst_tail <= 2.0 * 0.05,
-        "E_max jumped to {worst_tail} % after the last refinement"
+}
+
+/// A fit that stops unconverged ends at its best iteration since the last refinement: suzanne
+/// with Loop at the defaults (its budget of 253 control points spent) stalls 7 iterations
+/// after its best.
+#[test]
+fn a_fit_that_stalls_ends_at_its_best_iteration() {
+    let path = common::data_file("corpus/suzanne.obj");
+    if !path.exists() {
+        eprintln!("skipped: no {}", path.display());
+        return;
+    }
+    let mesh = read_path(&path).expect("the file reads").mesh;
+    let mut fit = FitSpec::new(Scheme::Loop)
+        .build(&FitData::points(&mesh))
+        .expect("the fit starts");
+    fit.run().expect("the fit runs");
+    assert_ends_at_best(&FitReport::of(fit.as_ref()));
+}
+
+/// While a fit pulls its worst points or its straying surface samples, no move throws others
+/// off: the bunny at Table 1 model C (Loop) stalled with E_max 0.43 %, one iteration after
+/// 0.047 %, when the heavy points of the pull dragged their neighbours off in a move the
+/// weighted objective accepted; later the pulled surface samples did the same (E_max 0.049 →
+/// 0.40 % in one move, E_back 0.36 → 0.14 %).
+#[test]
+fn no_move_throws_the_data_off_while_the_fit_pulls() {
+    let path = common::data_file("stanford-bunny.obj");
+    if !path.exists() {
+        eprintln!("skipped: no {}", path.display());
+        return;
+    }
+    let mesh = read_path(&path).expect("the file reads").mesh;
+    let mut spec = FitSpec::new(Scheme::Loop);
+    (spec.initial, spec.tol_avg, spec.tol_max) = (Some(612), Some(0.01), Some(0.05));
+    (spec.max_control, spec.max_iter) = (Some(7049), Some(60));
+    let mut fit = spec.build(&FitData::points(&mesh)).expect("the fit starts");
+    fit.run().expect("the fit runs");
+    let report = FitReport::of(fit.as_ref());
+    let history = &report.history;
+    let last_refined = history.iter().rposition(|r| r.refined).map_or(0, |i| i + 1);
+    let tail: Vec<f64> = history[last_refined..]
+        .iter()
+        .map(|r| r.e_max_pct)
+        .collect();
+    println!(
+        "bunny, model C: {:?} after {} iterations, E_max after the last refinement {tail:.4?}",
+        report.status, report.iterations
     );
+    // Each move's E_max against the one before (the last record may be the best iteration
+    // gone back to, not a move).
+    for (i, w) in tail[..tail.len().saturating_sub(1)].windows(2).enumerate() {
+        assert!(
+            w[1] <= (0.05f64).max(1.25 * w[0]) * (1.0 + 1e-9),
+            "E_max jumped {:.4} -> {:.4} % in iteration {}",
+            w[0],
+            w[1],
+            last_refined + i + 2
+        );
+    }
+    if report.ended_at_iteration.is_some() {
+        assert_ends_at_best(&report);
+    }
 }
 
 /// Doo–Sabin's split moves the surface (its new points are not those of a Doo–Sabin step), so
@@ -153,4 +195,81 @@ fn a_doo_sabin_split_that_moves_the_surface_is_kept() {
         r.final_control_points
     );
     assert!(r.e_max_pct < 0.2, "E_max {:.4} %", r.e_max_pct);
+}
+
+/// No move throws the surface off the data: a move after which E_back is beyond its bound
+/// and more than 1.5 × what it was before is shortened or undone, and the samples it threw off
+/// are held where they were. Cheburashka with Catmull–Clark at the defaults swung E_back
+/// 1.05 → 4.29 → 1.68 → 6.47 % in successive moves with nothing refined and stalled above the
+/// bound of 1 %.
+#[test]
+fn a_move_that_throws_the_surface_off_the_data_is_shortened() {
+    let path = common::data_file("corpus/cheburashka.obj");
+    if !path.exists() {
+        eprintln!("skipped: no {}", path.display());
+        return;
+    }
+    let mesh = read_path(&path).expect("the file reads").mesh;
+    let mut fit = FitSpec::new(Scheme::CatmullClark)
+        .build(&FitData::points(&mesh))
+        .expect("the fit starts");
+    fit.run().expect("the fit runs");
+    let r = FitReport::of(fit.as_ref());
+    let bound = BACK_TOLERANCE_FACTOR * fit.tolerances().max_pct.expect("an E_max tolerance");
+    let backs: Vec<f64> = r.history.iter().filter_map(|h| h.e_back_max_pct).collect();
+    println!(
+        "cheburashka Catmull-Clark: {:?} after {} iterations, E_back {backs:.3?}",
+        r.status, r.iterations
+    );
+    assert_eq!(
+        backs.len(),
+        r.history.len(),
+        "every iteration measures E_back"
+    );
+    // The last row carries the closing dense measure, which samples more than a move's check.
+    let n = r.history.len().saturating_sub(1);
+    for i in 1..n {
+        let (before, now) = (backs[i - 1], backs[i]);
+        if !r.history[i].refined {
+            assert!(
+                now <= bound.max(1.5 * before) * (1.0 + 1e-9),
+                "iteration {}: E_back {before:.3} -> {now:.3} % (bound {bound} %)",
+                i + 1
+            );
+        }
+    }
+}
+
+/// A control point the data barely reaches moves at most its mean control edge length in one
+/// iteration. suzanne's 507 vertices as bare points with Catmull–Clark (1,067 control points,
+/// more than the points) stalled with a sheet 30.8 % of the diagonal from suzanne's mesh.
+#[test]
+fn weakly_supported_control_points_do_not_fly_off() {
+    let path = common::data_file("corpus/suzanne.obj");
+    if !path.exists() {
+        eprintln!("skipped: no {}", path.display());
+        return;
+    }
+    let mesh = read_path(&path).expect("the file reads").mesh;
+    let points = geofit::mesh::PolyMesh::from_points(mesh.positions().to_vec()).expect("points");
+    let mut fit = FitSpec::new(Scheme::CatmullClark)
+        .build(&FitData::points(&points))
+        .expect("the fit starts");
+    fit.run().expect("the fit runs");
+    let Shape::Mesh(limit) = fit.limit_shape(16) else {
+        panic!("a subdivision fit has a limit mesh");
+    };
+    let source = geofit::fit::DataSurface::of_mesh(&mesh).expect("suzanne has faces");
+    let worst = source
+        .distances(limit.positions())
+        .into_iter()
+        .flatten()
+        .fold(0.0f64, f64::max);
+    let worst_pct = 100.0 * worst / mesh.bbox().expect("a box").diagonal();
+    let r = FitReport::of(fit.as_ref());
+    println!(
+        "suzanne's points, Catmull-Clark: {:?}, E_back {:?} %, {worst_pct:.2} % from the mesh",
+        r.status, r.e_back_max_pct
+    );
+    assert!(worst_pct < 10.0, "{worst_pct} % from suzanne's mesh");
 }

@@ -163,6 +163,17 @@ impl Stencils {
         }
     }
 
+    /// Which control points the rows reach weakly: support Σ_i B_ij² below `share` of the
+    /// median support.
+    pub(crate) fn weakly_supported(&self, share: f64) -> Vec<bool> {
+        let mut support = vec![0.0; self.columns];
+        for &(j, w) in &self.entries {
+            support[j as usize] += w * w;
+        }
+        let typical = median(&support);
+        support.iter().map(|&s| s < share * typical).collect()
+    }
+
     fn row(&self, i: usize) -> &[(u32, f64)] {
         &self.entries[self.starts[i]..self.starts[i + 1]]
     }
