@@ -149,7 +149,7 @@ pub struct Args {
     /// OpenSubdiv-based tools.
     #[arg(long)]
     usda: Option<PathBuf>,
-    /// Write the fitted surface, tessellated, as OBJ.
+    /// Write the fitted surface, tessellated, as OBJ (a B-spline surface cut to its trim).
     #[arg(long)]
     limit: Option<PathBuf>,
     /// Segments per patch edge of the --limit tessellation.
@@ -636,9 +636,18 @@ fn json_text(value: &impl Serialize, pretty: bool) -> Result<Vec<u8>, String> {
     text.map(String::into_bytes).map_err(|e| e.to_string())
 }
 
-/// The fitted surface tessellated with `segments` per patch edge, as OBJ.
+/// The fitted surface tessellated with `segments` per patch edge, as OBJ: a B-spline surface
+/// cut to its trim, as the page draws it and every other export writes it (the rectangle
+/// beyond the data curls away from it: bun000's least-squares fit at E_max 0.05 % reached
+/// 23 % of the diagonal from the data there).
 fn limit_obj(fitter: &dyn Fitter, segments: usize) -> Result<Vec<u8>, String> {
-    match fitter.limit_shape(segments) {
+    let trimmed = fitter
+        .trimmed_limit_shape(segments)
+        .map(|shape| match shape {
+            Shape::Mesh(mesh) => Shape::Mesh(mesh.without_unused_vertices().0),
+            curve => curve,
+        });
+    match trimmed.unwrap_or_else(|| fitter.limit_shape(segments)) {
         Shape::Mesh(mesh) => geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string()),
         Shape::Polyline { .. } => Err("--limit: a curve has no surface".into()),
     }
