@@ -119,6 +119,8 @@ pub(super) struct Engine {
     open: Vec<Candidate>,
     histogram: Vec<u32>,
     turn: Vec<u32>,
+    /// The candidates a wave tries, in order (see [`Engine::block_waves`]).
+    picks: Vec<usize>,
     /// How working indices relate to the input's.
     numbering: Numbering,
     /// Whether vertices without faces are dropped from the arrays once they are the majority
@@ -178,6 +180,7 @@ impl Engine {
             open: Vec::new(),
             histogram: Vec::new(),
             turn: Vec::new(),
+            picks: Vec::new(),
             numbering,
             scramble_ties: false,
             renumber: true,
@@ -562,17 +565,19 @@ impl Engine {
     ) -> (usize, usize) {
         let mut done = 0;
         let mut len = cands.len();
+        let mut picks = take(&mut self.picks);
         for _ in 0..MAX_WAVES {
             len = self.mark_cheapest(&mut cands[..len]);
             let stamp = self.wave << 32;
-            let mut tried = 0;
-            for i in 0..len {
-                let c = cands[i];
-                let mine = |end: u32| self.cheapest[end as usize].0 == stamp | i as u64;
-                if !mine(c.a) || !mine(c.b) {
-                    continue;
+            let mine = |i: usize, end: u32| self.cheapest[end as usize].0 == stamp | i as u64;
+            picks.clear();
+            picks.extend((0..len).filter(|&i| mine(i, cands[i].a) && mine(i, cands[i].b)));
+            let tried = picks.len();
+            for (j, &i) in picks.iter().enumerate() {
+                if let Some(&ahead) = picks.get(j + PICKS_AHEAD) {
+                    self.prefetch_faces(cands[ahead]);
                 }
-                tried += 1;
+                let c = cands[i];
                 if !self.try_collapse(ring, c.a, c.b, limits) {
                     cands[i].cost = f64::NAN;
                     continue;
@@ -580,6 +585,7 @@ impl Engine {
                 done += 1;
                 self.worst = self.worst.max(c.cost);
                 if self.live <= target {
+                    self.picks = picks;
                     return (done, len);
                 }
             }
@@ -588,7 +594,18 @@ impl Engine {
                 break;
             }
         }
+        self.picks = picks;
         (done, len)
+    }
+
+    /// Asks the processor to load the faces around the ends of `c` (see [`prefetch`]): the
+    /// collapse test reads them in an order that hardware prefetching cannot foresee.
+    fn prefetch_faces(&self, c: Candidate) {
+        for v in [c.a, c.b] {
+            for &f in self.faces_of(v) {
+                prefetch(&self.tris[f as usize]);
+            }
+        }
     }
 
     /// Starts a wave: drops the candidates that are out of the pass (refused, or an end
@@ -824,6 +841,10 @@ fn scramble(mut x: u32) -> u32 {
     x = x.wrapping_mul(0xc2b2_ae35);
     x ^ (x >> 16)
 }
+
+/// How many picks of a wave ahead of the collapse under test [`Engine::block_waves`]
+/// prefetches the faces of.
+const PICKS_AHEAD: usize = 2;
 
 /// How many faces ahead the sweeps over all faces ([`Engine::candidates`],
 /// [`Engine::set_planes`]) prefetch their corners' data.
