@@ -574,8 +574,13 @@ impl Engine {
             picks.extend((0..len).filter(|&i| mine(i, cands[i].a) && mine(i, cands[i].b)));
             let tried = picks.len();
             for (j, &i) in picks.iter().enumerate() {
-                if let Some(&ahead) = picks.get(j + PICKS_AHEAD) {
+                // Two stages: the faces of a later pick, then (now in the cache) the corners
+                // of a nearer one.
+                if let Some(&ahead) = picks.get(j + 2 * PICKS_AHEAD) {
                     self.prefetch_faces(cands[ahead]);
+                }
+                if let Some(&ahead) = picks.get(j + PICKS_AHEAD) {
+                    self.prefetch_corners_around(cands[ahead]);
                 }
                 let c = cands[i];
                 if !self.try_collapse(ring, c.a, c.b, limits) {
@@ -596,6 +601,21 @@ impl Engine {
         }
         self.picks = picks;
         (done, len)
+    }
+
+    /// Asks the processor to load the quadrics of the ends of `c` and the positions of the
+    /// corners of their faces (see [`prefetch`]), which the collapse test reads next to the
+    /// faces themselves; reads the faces, which [`Engine::prefetch_faces`] should have
+    /// brought into the cache.
+    fn prefetch_corners_around(&self, c: Candidate) {
+        for v in [c.a, c.b] {
+            prefetch(&self.quadric[v as usize]);
+            for &f in self.faces_of(v) {
+                for w in self.tris[f as usize].v {
+                    prefetch(&self.pos[w as usize]);
+                }
+            }
+        }
     }
 
     /// Asks the processor to load the faces around the ends of `c` (see [`prefetch`]): the
@@ -843,7 +863,7 @@ fn scramble(mut x: u32) -> u32 {
 }
 
 /// How many picks of a wave ahead of the collapse under test [`Engine::block_waves`]
-/// prefetches the faces of.
+/// prefetches the corners of (and twice as many ahead, the faces).
 const PICKS_AHEAD: usize = 2;
 
 /// How many faces ahead the sweeps over all faces ([`Engine::candidates`],
@@ -854,9 +874,11 @@ const PREFETCH_AHEAD: usize = 16;
 /// for them. The sweeps over all faces read each corner's quadric and position, which on a
 /// large mesh sit far apart in memory (Morton order keeps most neighbours close, not all), so
 /// they stalled on the loads: the costing of edges waited on its quadrics about 40 % of its
-/// time (perf, 4.4 M triangles). Prefetching a few faces ahead took 4–6 % off the whole
-/// simplification there, with an identical result (interleaved runs, see docs/subdivision.md).
-/// A no-op off x86-64 (the browser build).
+/// time (perf, 4.4 M triangles); so did the collapse test on the faces and positions around
+/// an edge. Prefetching took about 5 % (the sweeps) and 9 % (the waves) off the whole
+/// simplification of the 4.4 M mesh, 9 % off the bunny's in a warm process, with identical
+/// results (interleaved runs, see docs/subdivision.md). A no-op off x86-64 (the browser
+/// build).
 #[inline]
 fn prefetch<T>(x: &T) {
     #[cfg(target_arch = "x86_64")]
