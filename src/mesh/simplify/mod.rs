@@ -18,9 +18,10 @@
 //!
 //! Collapses are made in passes rather than from a priority queue (see the `engine` module).
 //! Measured on one core of a quiet 2-core VM (`bash scripts/bench_qem.sh`, figures in
-//! docs/subdivision.md): the Stanford bunny (69,451 triangles) to 612 vertices in 0.046–0.048 s,
-//! 1.45–1.5 M triangles per second; the bunny Loop-subdivided three times (4.4 M triangles) in
-//! 4.5 s, 1.0 M triangles per second, the whole process peaking at 175 bytes per input triangle.
+//! docs/subdivision.md): the Stanford bunny (69,451 triangles) to 612 vertices in 0.048 s cold,
+//! 1.45 M triangles per second (0.040 s warm); the bunny Loop-subdivided three times (4.4 M
+//! triangles) in 3.4–3.5 s, 1.3 M triangles per second, the whole process peaking at 175 bytes
+//! per input triangle.
 //!
 //! ```
 //! use geofit::geom::Point3;
