@@ -19,7 +19,6 @@ use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use kiddo::SquaredEuclidean;
 use rstar::{PointDistance, RTree, RTreeObject, AABB};
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 
 /// A sample whose nearest point on the data's boundary (the rim of a hole, the outline) is at
 /// most this many times as far as its nearest data point spans a hole: a surface sagging across
@@ -552,28 +551,58 @@ fn closest_on_triangle(p: Point3, a: Point3, b: Point3, c: Point3) -> (Point3, F
 
 /// Per triangle, the bit mask of its edges that no other triangle shares.
 fn boundary_edges(triangles: &[[u32; 3]]) -> Vec<u8> {
-    let mut count: HashMap<(u32, u32), u32> = HashMap::with_capacity(triangles.len() * 2);
-    let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    for t in triangles {
-        for k in 0..3 {
-            *count.entry(key(t[k], t[(k + 1) % 3])).or_default() += 1;
+    // Every edge of every triangle under its undirected key, sorted: a key that occurs once is
+    // open. A sort, not a hash map: hashing the 13 M edges of a 2.2 M-point scan took 4.5 s of
+    // its 19 s set-up.
+    let key = |a: u32, b: u32| (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+    let mut edges: Vec<(u64, usize)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(i, t)| (0..3).map(move |k| (key(t[k], t[(k + 1) % 3]), 3 * i + k)))
+        .collect();
+    edges.sort_unstable_by_key(|&(k, _)| k);
+    let mut open = vec![0u8; triangles.len()];
+    for run in edges.chunk_by(|a, b| a.0 == b.0) {
+        if let [(_, e)] = run {
+            open[e / 3] |= 1 << (e % 3);
         }
     }
-    triangles
-        .iter()
-        .map(|t| {
-            (0..3).fold(0u8, |m, k| {
-                let open = count.get(&key(t[k], t[(k + 1) % 3])) == Some(&1);
-                m | (u8::from(open) << k)
-            })
-        })
-        .collect()
+    open
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::geom::Vec3;
+
+    #[test]
+    fn an_edge_is_open_when_no_other_triangle_has_it() {
+        // Triangles over few vertices (so edges repeat, in both directions, and some
+        // triangles are degenerate), against counting every edge among all the others.
+        let mut state = 12345u64;
+        let mut next = |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) % n) as u32
+        };
+        let triangles: Vec<[u32; 3]> = (0..300).map(|_| [next(12), next(12), next(12)]).collect();
+        let key = |a: u32, b: u32| (a.min(b), a.max(b));
+        let edges = |t: &[u32; 3]| {
+            (0..3)
+                .map(|k| key(t[k], t[(k + 1) % 3]))
+                .collect::<Vec<_>>()
+        };
+        let all: Vec<_> = triangles.iter().flat_map(edges).collect();
+        let open = boundary_edges(&triangles);
+        for (t, &mask) in triangles.iter().zip(&open) {
+            for (k, e) in edges(t).into_iter().enumerate() {
+                let once = all.iter().filter(|&&x| x == e).count() == 1;
+                assert_eq!(mask & (1 << k) != 0, once, "{t:?} edge {k}");
+            }
+        }
+        assert!(open.iter().any(|&m| m != 0) && open.iter().any(|&m| m != 7));
+    }
 
     #[test]
     fn fine_samples_count_for_the_maximum_but_not_the_percentile() {
