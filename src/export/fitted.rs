@@ -89,17 +89,24 @@ pub fn step_of(fit: &dyn Fitter, name: &str) -> Result<String, ExportError> {
     write_step(&cad_model(fit)?, name)
 }
 
-/// The fitted surface tessellated for OBJ/PLY/STL/GLB ([`EXPORT_RESOLUTION`] segments per
-/// patch edge), a B-spline surface cut to its trim as the page draws it and STEP and IGES
-/// write it (the rectangle beyond the data curls away from it); a curve has none.
-pub fn surface_mesh(fit: &dyn Fitter) -> Result<PolyMesh, ExportError> {
+/// The fitted surface tessellated with `resolution` segments per patch edge, a B-spline
+/// surface cut to its trim (without the vertices of the quads left out): what the page draws
+/// and every mesh export writes.
+pub fn surface_shape(fit: &dyn Fitter, resolution: usize) -> Shape {
     let trimmed = fit
-        .trimmed_limit_shape(EXPORT_RESOLUTION)
+        .trimmed_limit_shape(resolution)
         .map(|shape| match shape {
             Shape::Mesh(mesh) => Shape::Mesh(mesh.without_unused_vertices().0),
             curve => curve,
         });
-    match trimmed.unwrap_or_else(|| fit.limit_shape(EXPORT_RESOLUTION)) {
+    trimmed.unwrap_or_else(|| fit.limit_shape(resolution))
+}
+
+/// The fitted surface tessellated for OBJ/PLY/STL/GLB ([`EXPORT_RESOLUTION`] segments per
+/// patch edge), a B-spline surface cut to its trim as the page draws it and STEP and IGES
+/// write it (the rectangle beyond the data curls away from it); a curve has none.
+pub fn surface_mesh(fit: &dyn Fitter) -> Result<PolyMesh, ExportError> {
+    match surface_shape(fit, EXPORT_RESOLUTION) {
         Shape::Mesh(mesh) => Ok(mesh),
         Shape::Polyline { .. } => Err(ExportError::Unsupported {
             what: format!(

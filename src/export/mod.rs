@@ -14,7 +14,8 @@ pub mod step;
 
 pub use cage::{cage_creases_json, cage_usda, CageCreases, INFINITE_SHARPNESS};
 pub use fitted::{
-    cad_model, cage_obj, exports_for, glb_of, iges_of, step_of, surface_mesh, EXPORT_RESOLUTION,
+    cad_model, cage_obj, exports_for, glb_of, iges_of, step_of, surface_mesh, surface_shape,
+    EXPORT_RESOLUTION,
 };
 
 use crate::geom::Point3;

@@ -641,13 +641,7 @@ fn json_text(value: &impl Serialize, pretty: bool) -> Result<Vec<u8>, String> {
 /// beyond the data curls away from it: bun000's least-squares fit at E_max 0.05 % reached
 /// 23 % of the diagonal from the data there).
 fn limit_obj(fitter: &dyn Fitter, segments: usize) -> Result<Vec<u8>, String> {
-    let trimmed = fitter
-        .trimmed_limit_shape(segments)
-        .map(|shape| match shape {
-            Shape::Mesh(mesh) => Shape::Mesh(mesh.without_unused_vertices().0),
-            curve => curve,
-        });
-    match trimmed.unwrap_or_else(|| fitter.limit_shape(segments)) {
+    match geofit::export::surface_shape(fitter, segments) {
         Shape::Mesh(mesh) => geofit::io::to_obj_bytes(&mesh).map_err(|e| e.to_string()),
         Shape::Polyline { .. } => Err("--limit: a curve has no surface".into()),
     }
