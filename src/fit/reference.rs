@@ -39,6 +39,10 @@ pub const HOLE_RADII: f64 = 3.0;
 /// many triangles, and the R-tree's best-first search finds the nearest sooner.
 const SEED_REACH: f64 = 2.0;
 
+/// How many triangles farther than the nearest found [`DataSurface::search_f32`] looks at
+/// before it stops, when f32 cannot order them (equally near ones are all looked at).
+const MAX_TIED: usize = 64;
+
 /// The surface → data distances of one fitted surface: their largest and 99th-percentile values
 /// in % of the data's bounding-box diagonal, over the samples that lie over data.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -118,23 +122,72 @@ impl Triangle {
         self.corners
             .map(|[x, y, z]| Point3::new(x as f64, y as f64, z as f64))
     }
-}
 
-impl RTreeObject for Triangle {
-    type Envelope = AABB<[f64; 3]>;
-
-    fn envelope(&self) -> Self::Envelope {
+    /// The squared distance from `p` to the triangle, in f64: what decides the nearest.
+    fn dist_sq(&self, p: Point3) -> f64 {
         let [a, b, c] = self.points();
-        AABB::from_corners(a.min(b).min(c).to_array(), a.max(b).max(c).to_array())
-    }
-}
-
-impl PointDistance for Triangle {
-    fn distance_2(&self, p: &[f64; 3]) -> f64 {
-        let [a, b, c] = self.points();
-        let p = Point3::from_array(*p);
         (p - closest_on_triangle(p, a, b, c).0).length_squared()
     }
+}
+
+/// The tree's boxes and queries are f32, as the corners are: f64 boxes made every node of the
+/// tree 80 bytes instead of 56 (rstar's node is an enum of a leaf and a parent, whose box is
+/// two points), 221 bytes a data point on a 2-million-point scan. Queries round their boxes
+/// outwards and every candidate's distance is then taken in f64 ([`Triangle::dist_sq`]), so
+/// the answer is what an f64 tree gives.
+impl RTreeObject for Triangle {
+    type Envelope = AABB<[f32; 3]>;
+
+    fn envelope(&self) -> Self::Envelope {
+        let [a, b, c] = self.corners;
+        let corner =
+            |pick: fn(f32, f32) -> f32| std::array::from_fn(|k| pick(pick(a[k], b[k]), c[k]));
+        AABB::from_corners(corner(f32::min), corner(f32::max))
+    }
+}
+
+/// The distance to the f32 query point, for the R-tree's own best-first search
+/// ([`DataSurface::nearest`] settles the answer in f64).
+impl PointDistance for Triangle {
+    fn distance_2(&self, p: &[f32; 3]) -> f32 {
+        self.dist_sq(Point3::from_array(p.map(f64::from))) as f32
+    }
+}
+
+/// The f32 box that holds the f64 box `lo`..`hi`: its corners rounded outwards.
+fn outward_box(lo: Point3, hi: Point3) -> AABB<[f32; 3]> {
+    let below = |x: f64| {
+        let y = x as f32;
+        if f64::from(y) > x {
+            next_f32(y, -1)
+        } else {
+            y
+        }
+    };
+    let above = |x: f64| {
+        let y = x as f32;
+        if f64::from(y) < x {
+            next_f32(y, 1)
+        } else {
+            y
+        }
+    };
+    AABB::from_corners(lo.to_array().map(below), hi.to_array().map(above))
+}
+
+/// The f32 next to finite or infinite `y` towards +∞ (`step` 1) or −∞ (−1); `f32::next_up`
+/// and `next_down` need a newer Rust than the crate's minimum.
+fn next_f32(y: f32, step: i32) -> f32 {
+    if y.is_nan() || (y.is_infinite() && (y > 0.0) == (step > 0)) {
+        return y;
+    }
+    if y == 0.0 {
+        let tiny = f32::from_bits(1);
+        return if step > 0 { tiny } else { -tiny };
+    }
+    let bits = y.to_bits();
+    let away = (y > 0.0) == (step > 0);
+    f32::from_bits(if away { bits + 1 } else { bits - 1 })
 }
 
 /// A boundary edge of the data, for the distance to the data's rim.
@@ -390,10 +443,9 @@ impl DataSurface {
         if !p.is_finite() {
             return None;
         }
-        let at = p.to_array();
         let mut best: Option<(f64, &'a Triangle)> = None;
         let mut consider = |t: &'a Triangle| {
-            let d = t.distance_2(&at);
+            let d = t.dist_sq(p);
             if best.is_none_or(|(bd, bt)| d < bd || (d == bd && t.index < bt.index)) {
                 best = Some((d, t));
             }
@@ -402,16 +454,11 @@ impl DataSurface {
             Some(bound) => {
                 // Widened by a little more than rounding: the box must hold the nearest point.
                 let r = bound.sqrt() * (1.0 + 1e-9) + f64::EPSILON * p.abs().max_element();
-                let reach = AABB::from_corners((p - r).to_array(), (p + r).to_array());
                 self.tree
-                    .locate_in_envelope_intersecting(&reach)
+                    .locate_in_envelope_intersecting(&outward_box(p - r, p + r))
                     .for_each(&mut consider);
             }
-            None => self
-                .tree
-                .nearest_neighbors(&at)
-                .into_iter()
-                .for_each(&mut consider),
+            None => self.search_f32(p, &mut consider),
         }
         let t = best?.1;
         let [a, b, c] = t.points();
@@ -428,6 +475,37 @@ impl DataSurface {
             on_boundary,
             sagitta: t.sagitta as f64,
         })
+    }
+
+    /// The R-tree's best-first search from `p` rounded to f32, handing `consider` every
+    /// triangle that can be the nearest to `p` itself: the rounding moves the query by
+    /// `shift`, so the f32 order can put a triangle up to `shift` nearer or farther than it
+    /// is, and the search goes on until the f32 distances pass the nearest exact one found by
+    /// more than that (or [`MAX_TIED`] triangles later, for a query so far out that f32 cannot
+    /// tell the triangles apart at all).
+    fn search_f32<'a>(&'a self, p: Point3, consider: &mut impl FnMut(&'a Triangle)) {
+        let q = p.as_vec3();
+        let shift = (p - q.as_dvec3()).length();
+        let mut nearest = f64::INFINITY;
+        let mut beyond = 0;
+        for (t, d) in self
+            .tree
+            .nearest_neighbor_iter_with_distance_2(&q.to_array())
+        {
+            // The f32 distance is rounded too: a relative 1e-6 covers it.
+            if f64::from(d).sqrt() * (1.0 - 1e-6) > nearest + 2.0 * shift {
+                break;
+            }
+            let exact = t.dist_sq(p).sqrt();
+            if exact > nearest {
+                beyond += 1;
+                if beyond > MAX_TIED {
+                    break;
+                }
+            }
+            nearest = nearest.min(exact);
+            consider(t);
+        }
     }
 
     /// An upper bound of the squared distance from `p` to the data's triangles that is close
@@ -665,17 +743,37 @@ mod tests {
                 (2.0 * random() - 1.0) * height,
             );
             let foot = s.nearest(p - s.origin).expect("finite");
-            let q = (p - s.origin).to_array();
+            let q = p - s.origin;
             let best = everything
                 .iter()
                 .min_by(|a, b| {
-                    a.distance_2(&q)
-                        .total_cmp(&b.distance_2(&q))
+                    a.dist_sq(q)
+                        .total_cmp(&b.dist_sq(q))
                         .then(a.index.cmp(&b.index))
                 })
                 .expect("triangles");
-            assert_eq!(foot.dist_sq, best.distance_2(&q), "query {k} at {p:?}");
+            assert_eq!(foot.dist_sq, best.dist_sq(q), "query {k} at {p:?}");
             assert_eq!(foot.sagitta, best.sagitta as f64, "query {k} at {p:?}");
+        }
+        // Beyond what f32 can tell apart (the tree's boxes are f32), a query still gets a
+        // triangle at its distance, and soon.
+        for far in [1e12, 1e30, 1e300] {
+            let p = Point3::new(far, -far, 0.5 * far);
+            let foot = s.nearest(p).expect("finite");
+            let nearest = everything
+                .iter()
+                .map(|t| t.dist_sq(p))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                foot.dist_sq.is_finite() || far > 1e150,
+                "{far}: {}",
+                foot.dist_sq
+            );
+            assert!(
+                foot.dist_sq <= nearest * (1.0 + 1e-6),
+                "{far}: {} > {nearest}",
+                foot.dist_sq
+            );
         }
     }
 
