@@ -76,11 +76,16 @@ impl FitState {
     /// [`FitState::closest_data`]), of which the first `uniform` sample the surface evenly
     /// ([`BackStats::of_mixed`]); none when no reference is set.
     pub(crate) fn set_back(&mut self, closest: &[Option<(f64, Point3)>], uniform: usize) {
+        let distances: Vec<Option<f64>> = closest.iter().map(|c| c.map(|(d, _)| d)).collect();
+        self.set_back_distances(&distances, uniform);
+    }
+
+    /// [`FitState::set_back`] from the distances alone.
+    pub(crate) fn set_back_distances(&mut self, distances: &[Option<f64>], uniform: usize) {
         if self.reference.is_none() {
             return;
         }
-        let distances: Vec<Option<f64>> = closest.iter().map(|c| c.map(|(d, _)| d)).collect();
-        self.back = Some(BackStats::of_mixed(&distances, uniform, self.diagonal));
+        self.back = Some(BackStats::of_mixed(distances, uniform, self.diagonal));
     }
 
     /// The distance to the data of every one of `points` (points of the fitted surface, such
