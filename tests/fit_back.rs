@@ -4,23 +4,36 @@
 
 mod common;
 
-use geofit::fit::{FitData, FitReport, FitSpec, FitStatus, Scheme, Shape, BACK_TOLERANCE_FACTOR};
+use geofit::fit::{
+    FitData, FitReport, FitSpec, FitStatus, Fitter, Scheme, Shape, BACK_TOLERANCE_FACTOR,
+};
 use geofit::io::read_path;
+use geofit::mesh::PolyMesh;
 
-/// Fits `file` (of the repository's data) with `scheme` at the defaults and returns the report,
-/// the surface → data bound and the largest distance of the 16 × 16 tessellation's vertices to
-/// the data, both % of the diagonal; `None` when the data is not there.
-fn fit_and_measure(file: &str, scheme: Scheme) -> Option<(FitReport, f64, f64)> {
+/// The mesh of `file` (of the repository's data); `None`, and the test skipped, when the data
+/// is not there.
+fn data_mesh(file: &str) -> Option<PolyMesh> {
     let path = common::data_file(file);
     if !path.exists() {
         eprintln!("skipped: no {}", path.display());
         return None;
     }
-    let mesh = read_path(&path).expect("the file reads").mesh;
-    let mut fit = FitSpec::new(scheme)
-        .build(&FitData::points(&mesh))
-        .expect("the fit starts");
+    Some(read_path(&path).expect("the file reads").mesh)
+}
+
+/// `spec` fitted to `data` until it stops.
+fn run(spec: &FitSpec, data: &PolyMesh) -> Box<dyn Fitter> {
+    let mut fit = spec.build(&FitData::points(data)).expect("the fit starts");
     fit.run().expect("the fit runs");
+    fit
+}
+
+/// Fits `file` (of the repository's data) with `scheme` at the defaults and returns the report,
+/// the surface → data bound and the largest distance of the 16 × 16 tessellation's vertices to
+/// the data, both % of the diagonal; `None` when the data is not there.
+fn fit_and_measure(file: &str, scheme: Scheme) -> Option<(FitReport, f64, f64)> {
+    let mesh = data_mesh(file)?;
+    let fit = run(&FitSpec::new(scheme), &mesh);
     let Shape::Mesh(limit) = fit.limit_shape(16) else {
         panic!("a subdivision fit has a limit mesh");
     };
@@ -111,16 +124,10 @@ fn assert_ends_at_best(report: &FitReport) {
 /// after its best.
 #[test]
 fn a_fit_that_stalls_ends_at_its_best_iteration() {
-    let path = common::data_file("corpus/suzanne.obj");
-    if !path.exists() {
-        eprintln!("skipped: no {}", path.display());
+    let Some(mesh) = data_mesh("corpus/suzanne.obj") else {
         return;
-    }
-    let mesh = read_path(&path).expect("the file reads").mesh;
-    let mut fit = FitSpec::new(Scheme::Loop)
-        .build(&FitData::points(&mesh))
-        .expect("the fit starts");
-    fit.run().expect("the fit runs");
+    };
+    let fit = run(&FitSpec::new(Scheme::Loop), &mesh);
     assert_ends_at_best(&FitReport::of(fit.as_ref()));
 }
 
@@ -131,17 +138,13 @@ fn a_fit_that_stalls_ends_at_its_best_iteration() {
 /// 0.40 % in one move, E_back 0.36 → 0.14 %).
 #[test]
 fn no_move_throws_the_data_off_while_the_fit_pulls() {
-    let path = common::data_file("stanford-bunny.obj");
-    if !path.exists() {
-        eprintln!("skipped: no {}", path.display());
+    let Some(mesh) = data_mesh("stanford-bunny.obj") else {
         return;
-    }
-    let mesh = read_path(&path).expect("the file reads").mesh;
+    };
     let mut spec = FitSpec::new(Scheme::Loop);
     (spec.initial, spec.tol_avg, spec.tol_max) = (Some(612), Some(0.01), Some(0.05));
     (spec.max_control, spec.max_iter) = (Some(7049), Some(60));
-    let mut fit = spec.build(&FitData::points(&mesh)).expect("the fit starts");
-    fit.run().expect("the fit runs");
+    let fit = run(&spec, &mesh);
     let report = FitReport::of(fit.as_ref());
     let history = &report.history;
     let last_refined = history.iter().rposition(|r| r.refined).map_or(0, |i| i + 1);
@@ -204,16 +207,10 @@ fn a_doo_sabin_split_that_moves_the_surface_is_kept() {
 /// bound of 1 %.
 #[test]
 fn a_move_that_throws_the_surface_off_the_data_is_shortened() {
-    let path = common::data_file("corpus/cheburashka.obj");
-    if !path.exists() {
-        eprintln!("skipped: no {}", path.display());
+    let Some(mesh) = data_mesh("corpus/cheburashka.obj") else {
         return;
-    }
-    let mesh = read_path(&path).expect("the file reads").mesh;
-    let mut fit = FitSpec::new(Scheme::CatmullClark)
-        .build(&FitData::points(&mesh))
-        .expect("the fit starts");
-    fit.run().expect("the fit runs");
+    };
+    let fit = run(&FitSpec::new(Scheme::CatmullClark), &mesh);
     let r = FitReport::of(fit.as_ref());
     let bound = BACK_TOLERANCE_FACTOR * fit.tolerances().max_pct.expect("an E_max tolerance");
     let backs: Vec<f64> = r.history.iter().filter_map(|h| h.e_back_max_pct).collect();
@@ -245,17 +242,11 @@ fn a_move_that_throws_the_surface_off_the_data_is_shortened() {
 /// more than the points) stalled with a sheet 30.8 % of the diagonal from suzanne's mesh.
 #[test]
 fn weakly_supported_control_points_do_not_fly_off() {
-    let path = common::data_file("corpus/suzanne.obj");
-    if !path.exists() {
-        eprintln!("skipped: no {}", path.display());
+    let Some(mesh) = data_mesh("corpus/suzanne.obj") else {
         return;
-    }
-    let mesh = read_path(&path).expect("the file reads").mesh;
+    };
     let points = geofit::mesh::PolyMesh::from_points(mesh.positions().to_vec()).expect("points");
-    let mut fit = FitSpec::new(Scheme::CatmullClark)
-        .build(&FitData::points(&points))
-        .expect("the fit starts");
-    fit.run().expect("the fit runs");
+    let fit = run(&FitSpec::new(Scheme::CatmullClark), &points);
     let Shape::Mesh(limit) = fit.limit_shape(16) else {
         panic!("a subdivision fit has a limit mesh");
     };
@@ -279,16 +270,10 @@ fn weakly_supported_control_points_do_not_fly_off() {
 /// scan once reported 0 s of fit for a 0.8 s check).
 #[test]
 fn a_fit_that_converges_at_once_counts_its_check() {
-    let path = common::data_file("corpus/woody.obj");
-    if !path.exists() {
-        eprintln!("skipped: no {}", path.display());
+    let Some(mesh) = data_mesh("corpus/woody.obj") else {
         return;
-    }
-    let mesh = read_path(&path).expect("the file reads").mesh;
-    let mut fit = FitSpec::new(Scheme::Loop)
-        .build(&FitData::points(&mesh))
-        .expect("the fit starts");
-    fit.run().expect("the fit runs");
+    };
+    let fit = run(&FitSpec::new(Scheme::Loop), &mesh);
     let r = FitReport::of(fit.as_ref());
     assert_eq!((r.status, r.iterations), (FitStatus::Converged, 0));
     assert!(r.fit_s > 0.0, "fit {} s", r.fit_s);
