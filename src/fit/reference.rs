@@ -219,14 +219,11 @@ pub struct DataSurface {
     /// origin) would otherwise be rounded to a quarter of a metre.
     origin: Point3,
     tree: RTree<Triangle>,
-    /// Where a query starts ([`DataSurface::seed_bound`]): the data's vertices...
+    /// Where a query starts ([`DataSurface::seed_bound`]): the vertices of the data's
+    /// triangles (relative to the origin), each with the longest edge of its triangles
+    /// (`reach`, by the kd-tree's item).
     vertices: ImmutableKdTree<f32, u32, 3, 32>,
-    /// ...their positions (relative to the origin) and, per vertex, its triangles (CSR: those
-    /// of vertex v are `incident[first[v]..first[v + 1]]`), with each triangle's corners.
-    positions: Vec<[f32; 3]>,
-    first: Vec<usize>,
-    incident: Vec<u32>,
-    triangles: Vec<[u32; 3]>,
+    reach: Vec<f32>,
     /// The boundary edges (none on a closed mesh).
     rim: RTree<Rim>,
     /// The data points in no triangle (a scanner's points in a hole of the mesh, say): the
@@ -317,26 +314,18 @@ impl DataSurface {
             .filter(|(_, &u)| !u)
             .map(|(p, _)| *p)
             .collect();
-        let all: ImmutableKdTree<f32, u32, 3, 32> = ImmutableKdTree::new_from_slice(&positions);
-        let two = std::num::NonZero::<usize>::new(2).unwrap_or(std::num::NonZero::<usize>::MIN);
-        let loose_spacing = loose
-            .iter()
-            .map(|q| {
-                let near = all.nearest_n::<SquaredEuclidean>(q, two);
-                near.last().map_or(0.0, |n| n.distance.sqrt())
-            })
-            .collect();
-        let (first, incident) = crate::mesh::vertex_faces(positions.len(), &triangles);
+        let (vertices, reach) = seed_vertices(&positions, &triangles);
+        let loose_tree = (!loose.is_empty()).then(|| ImmutableKdTree::new_from_slice(&loose));
+        let loose_spacing = loose_tree
+            .as_ref()
+            .map_or_else(Vec::new, |t| spacing(&loose, t, &vertices));
         Some(DataSurface {
             origin,
             tree: RTree::bulk_load(objects),
-            vertices: all,
-            positions,
-            first,
-            incident,
-            triangles,
+            vertices,
+            reach,
             rim: RTree::bulk_load(rim),
-            loose: (!loose.is_empty()).then(|| ImmutableKdTree::new_from_slice(&loose)),
+            loose: loose_tree,
             loose_points: loose,
             loose_spacing,
             surfels: None,
@@ -509,31 +498,65 @@ impl DataSurface {
     }
 
     /// An upper bound of the squared distance from `p` to the data's triangles that is close
-    /// to it: the distance to the nearest of the nearest vertex's triangles. `None` where that
-    /// bound would be loose — the nearest vertex in no face, or `p` farther from it than
-    /// [`SEED_REACH`] of its triangles' longest edge — and the R-tree's own search is quicker.
+    /// to it: the distance to the nearest vertex of a triangle, widened by the f32 rounding of
+    /// the kd-tree's query and distance. `None` where that bound would be loose — `p` farther
+    /// from the vertex than [`SEED_REACH`] of its triangles' longest edge — and the R-tree's
+    /// own search is quicker.
+    ///
+    /// Why the vertex and not the nearest of its triangles (a tighter bound, 2026-12-07
+    /// before): that needed every vertex's triangles and their corners beside the R-tree,
+    /// 68 bytes a data point on a 2-million-point scan; the box the vertex's distance spans
+    /// holds a few more triangles, whose distances are cheap.
     fn seed_bound(&self, p: Point3) -> Option<f64> {
-        let q = p.as_vec3().to_array();
-        let v = self.vertices.nearest_one::<SquaredEuclidean>(&q).item as usize;
-        let around = self
-            .incident
-            .get(*self.first.get(v)?..*self.first.get(v + 1)?)?;
-        let corner = |i: u32| {
-            let [x, y, z] = self.positions[i as usize];
-            Point3::new(x as f64, y as f64, z as f64)
-        };
-        let mut bound = f64::INFINITY;
-        let mut edge = 0.0f64;
-        for &t in around {
-            let [a, b, c] = self.triangles[t as usize].map(corner);
-            bound = bound.min((p - closest_on_triangle(p, a, b, c).0).length_squared());
-            edge = edge
-                .max((a - b).length_squared())
-                .max((b - c).length_squared())
-                .max((c - a).length_squared());
-        }
-        (bound <= SEED_REACH * SEED_REACH * edge).then_some(bound)
+        let q = p.as_vec3();
+        let near = self.vertices.nearest_one::<SquaredEuclidean>(&q.to_array());
+        let shift = (p - q.as_dvec3()).length();
+        let reach = f64::from(*self.reach.get(near.item as usize)?);
+        let r = f64::from(near.distance).sqrt() * (1.0 + 1e-5) + shift;
+        (r <= SEED_REACH * reach).then_some(r * r)
     }
+}
+
+/// The distance from each of the `loose` points (in the kd-tree `tree`) to its nearest other
+/// data point: another loose one or a vertex of the triangles (`vertices`).
+fn spacing(
+    loose: &[[f32; 3]],
+    tree: &ImmutableKdTree<f32, u32, 3, 32>,
+    vertices: &ImmutableKdTree<f32, u32, 3, 32>,
+) -> Vec<f32> {
+    let two = std::num::NonZero::<usize>::new(2).unwrap_or(std::num::NonZero::<usize>::MIN);
+    loose
+        .iter()
+        .map(|q| {
+            // The nearest loose point is the point itself.
+            let other = tree.nearest_n::<SquaredEuclidean>(q, two);
+            let other = other.get(1).map_or(f32::INFINITY, |n| n.distance);
+            let vertex = vertices.nearest_one::<SquaredEuclidean>(q).distance;
+            other.min(vertex).sqrt()
+        })
+        .collect()
+}
+
+/// The kd-tree of the vertices of `triangles` (of `positions`) and, by its items, the
+/// longest edge of each vertex's triangles.
+fn seed_vertices(
+    positions: &[[f32; 3]],
+    triangles: &[[u32; 3]],
+) -> (ImmutableKdTree<f32, u32, 3, 32>, Vec<f32>) {
+    let mut longest = vec![-1.0f32; positions.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|i| Point3::from_array(positions[i as usize].map(f64::from)));
+        let edge = a.distance(b).max(b.distance(c)).max(c.distance(a)) as f32;
+        for &v in t {
+            longest[v as usize] = longest[v as usize].max(edge);
+        }
+    }
+    let used: Vec<usize> = (0..positions.len())
+        .filter(|&v| longest[v] >= 0.0)
+        .collect();
+    let points: Vec<[f32; 3]> = used.iter().map(|&v| positions[v]).collect();
+    let reach = used.iter().map(|&v| longest[v]).collect();
+    (ImmutableKdTree::new_from_slice(&points), reach)
 }
 
 /// How far a smooth surface through the corners of a data triangle may bulge from the flat

@@ -10,7 +10,6 @@ mod simplify;
 mod validate;
 
 pub use error::MeshError;
-pub(crate) use features::vertex_faces;
 pub use features::{detect_features, FeatureLine, FeatureOptions, Features};
 pub use halfedge::{ControlMesh, ControlMeshError, NONE};
 pub use poly::PolyMesh;
