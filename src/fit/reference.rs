@@ -34,9 +34,10 @@ pub const RIM_FACTOR: f64 = 2.0;
 /// opened in the closed object's reconstruction.
 pub const HOLE_RADII: f64 = 3.0;
 
-/// How far from its nearest vertex's triangles, in their longest edges, a query may lie and
-/// still start from them ([`DataSurface::seed_bound`]): farther, the box that bound spans holds
-/// many triangles, and the R-tree's best-first search finds the nearest sooner.
+/// How far from its nearest vertex of a triangle, in the longest edge of that vertex's
+/// triangles, a query may lie and still start from it ([`DataSurface::seed_bound`]): farther,
+/// the box that bound spans holds many triangles, and the R-tree's best-first search finds the
+/// nearest sooner.
 const SEED_REACH: f64 = 2.0;
 
 /// How many triangles farther than the nearest found [`DataSurface::search_f32`] looks at
@@ -424,10 +425,10 @@ impl DataSurface {
     ///
     /// Why not the R-tree's own nearest-neighbour query: its best-first search with a heap took
     /// a third of a bunny fit (every iteration measures tens of thousands of samples, each
-    /// hardly off the data). A sample's nearest triangle is almost always one of its nearest
-    /// vertex's, so those give a tight bound ([`DataSurface::seed_bound`]) and the R-tree only
-    /// has to list the few triangles whose boxes reach within it. Of the triangles equally
-    /// near, the first in the data's order counts, however they were found.
+    /// hardly off the data). A sample near the data is about as near to the nearest vertex of
+    /// a triangle, so that distance is a close bound ([`DataSurface::seed_bound`]) and the
+    /// R-tree only has to list the few triangles whose boxes reach within it. Of the triangles
+    /// equally near, the first in the data's order counts, however they were found.
     fn nearest<'a>(&'a self, p: Point3) -> Option<Foot> {
         if !p.is_finite() {
             return None;
