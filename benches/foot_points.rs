@@ -78,6 +78,8 @@ fn best(pass: impl Fn() -> FootPointTiming) -> (FootPointTiming, f64) {
 }
 
 fn main() {
+    // One thread: the figure is per core, and thread CPU time counts only this thread.
+    geofit::fit::set_max_threads(1);
     let args: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with('-'))
