@@ -6,12 +6,14 @@ mod coords;
 mod eigen;
 mod nearest;
 mod order;
+mod prefetch;
 
 pub use aabb::Aabb;
 pub use coords::{check_coordinates, find_strays, BadCoordinate, COORDINATE_LIMIT};
 pub use eigen::{principal_frame, symmetric_eigen, Frame};
 pub use nearest::{ClosestPoint, Nearest, NewtonOptions};
 pub(crate) use order::{median, quantile};
+pub(crate) use prefetch::{prefetch, prefetch_slice};
 
 /// A point in 3D space (f64). An alias of glam's `DVec3`, so points and vectors share maths.
 pub type Point3 = glam::DVec3;

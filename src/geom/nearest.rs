@@ -87,4 +87,8 @@ pub trait ClosestPoint {
         start: Self::Param,
         options: &NewtonOptions,
     ) -> Nearest<Self::Param>;
+
+    /// A hint that a search from `at` comes soon: the shape may ask the processor to load the
+    /// data evaluation there reads (see [`crate::geom::prefetch`]). Changes no result.
+    fn prefetch(&self, _at: &Self::Param) {}
 }

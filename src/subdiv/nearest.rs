@@ -16,6 +16,10 @@ impl ClosestPoint for SubdivSurface {
     ) -> Nearest<SurfaceParam> {
         newton_foot(self, p, start, options)
     }
+
+    fn prefetch(&self, at: &SurfaceParam) {
+        self.prefetch_patch(*at);
+    }
 }
 
 /// The foot point of `p` on `surface` by a damped Newton iteration from `start`.

@@ -917,6 +917,16 @@ impl Graph {
         sc.entries.get(e as usize)
     }
 
+    /// Where the data of the sub-patch of shortcut `id` holding (u, v) lies in a patch's cached
+    /// data: its offset and length.
+    #[inline]
+    pub fn shortcut_span(&self, id: u32, u: f64, v: f64) -> Option<(usize, usize)> {
+        match self.entry(id, u, v)? {
+            Entry::Leaf { offset, .. } => Some((*offset, self.power.len())),
+            Entry::Deep { offset, kd, .. } => Some((*offset, *kd)),
+        }
+    }
+
     /// Limit point and derivatives at (u, v) of a patch with shortcut `id` and cached data
     /// `cache` (from [`Graph::fill_shortcut`]).
     #[inline]

@@ -6,7 +6,7 @@ use super::patch::{neighbourhood, vertex_neighbourhood, Graph, Kind};
 use super::sites::DooSabinSites;
 use super::topo::Topo;
 use super::{LimitEval, LimitSurface, PatchDomain, Scheme, SubdivError, SurfaceParam};
-use crate::geom::{Point3, Vec3};
+use crate::geom::{prefetch_slice, Point3, Vec3};
 use crate::mesh::{ControlMesh, NONE};
 
 /// Where a patch's local points come from, and how to evaluate it.
@@ -359,6 +359,26 @@ impl SubdivSurface {
                 e.du.cross(e.dv).normalize_or_zero()
             })
             .collect()
+    }
+
+    /// Asks the processor to load the cached data that evaluation at `at` reads (a hint: the
+    /// next foot point's patch is known one or more points ahead, and its data is otherwise a
+    /// cache miss, as patches are visited in the data's order).
+    pub(crate) fn prefetch_patch(&self, at: SurfaceParam) {
+        let Some((p, u, v)) = self.patch(at) else {
+            return;
+        };
+        let span = if p.direct {
+            Some((0, self.graph.power().len()))
+        } else {
+            self.graph.shortcut_span(p.shortcut, u, v)
+        };
+        if let Some(data) = span.and_then(|(offset, len)| {
+            let start = p.cache as usize + offset;
+            self.cache.get(start..start + len)
+        }) {
+            prefetch_slice(data);
+        }
     }
 
     fn patch(&self, at: SurfaceParam) -> Option<(&Patch, f64, f64)> {

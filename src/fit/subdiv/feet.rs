@@ -76,6 +76,15 @@ pub(crate) fn cold_feet<S: ClosestPoint<Param = SurfaceParam> + Sync>(
     Ok(feet)
 }
 
+/// How many points ahead [`warm_feet`] asks for the patch data at the previous foot point
+/// ([`ClosestPoint::prefetch`]). Points come in data order, which visits patches in no order
+/// the hardware can foresee, and an irregular patch's data (about 3 KB) is mostly not in
+/// cache: on the bunny's final Loop surface the first evaluation of a warm foot point waited on
+/// its first load for about 40 % of its time (perf). Asking 4 points ahead (2, 4 and 8 measured
+/// the same) took the warm pass from 1.45–1.58 to 1.78–1.83 M foot points/s (best pass, one
+/// thread); results are the same bits.
+const PREFETCH_AHEAD: usize = 4;
+
 /// Every point's foot point from its previous one ([`warm_foot`]) into `out`, on several
 /// threads (the same result on any number).
 pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam> + Sync>(
@@ -88,6 +97,9 @@ pub(crate) fn warm_feet<S: ClosestPoint<Param = SurfaceParam> + Sync>(
     out: &mut [FootPoint],
 ) {
     parallel::fill(out, |i| {
+        if let Some(ahead) = previous.get(i + PREFETCH_AHEAD) {
+            surface.prefetch(&ahead.param);
+        }
         warm_foot(surface, index, data[i], &previous[i], opts, slack)
     });
 }

@@ -29,7 +29,7 @@ use super::check::{Corner, Limits, Ring};
 use super::locality::Numbering;
 use super::quadric::{placement, Quadric};
 use super::rank::cost_at_rank;
-use crate::geom::{Point3, Vec3};
+use crate::geom::{prefetch, Point3, Vec3};
 use crate::mesh::repair::clean::has_area;
 use std::mem::take;
 
@@ -451,7 +451,7 @@ impl Engine {
     }
 
     /// Asks the processor to load the positions and the `quadric` entries of face `f`'s
-    /// corners (nothing when there is no face `f`): see [`prefetch`].
+    /// corners (nothing when there is no face `f`): see [`PREFETCH_AHEAD`].
     #[inline]
     fn prefetch_corners(&self, f: usize, quadric: &[Quadric]) {
         if let Some(face) = self.tris.get(f) {
@@ -604,7 +604,7 @@ impl Engine {
     }
 
     /// Asks the processor to load the quadrics of the ends of `c` and the positions of the
-    /// corners of their faces (see [`prefetch`]), which the collapse test reads next to the
+    /// corners of their faces (see [`PREFETCH_AHEAD`]), which the collapse test reads next to the
     /// faces themselves; reads the faces, which [`Engine::prefetch_faces`] should have
     /// brought into the cache.
     fn prefetch_corners_around(&self, c: Candidate) {
@@ -618,7 +618,7 @@ impl Engine {
         }
     }
 
-    /// Asks the processor to load the faces around the ends of `c` (see [`prefetch`]): the
+    /// Asks the processor to load the faces around the ends of `c` (see [`PREFETCH_AHEAD`]): the
     /// collapse test reads them in an order that hardware prefetching cannot foresee.
     fn prefetch_faces(&self, c: Candidate) {
         for v in [c.a, c.b] {
@@ -868,34 +868,16 @@ const PICKS_AHEAD: usize = 2;
 
 /// How many faces ahead the sweeps over all faces ([`Engine::candidates`],
 /// [`Engine::set_planes`]) prefetch their corners' data.
+///
+/// Why prefetch at all: the sweeps read each corner's quadric and position, which on a large
+/// mesh sit far apart in memory (Morton order keeps most neighbours close, not all), so they
+/// stalled on the loads: the costing of edges waited on its quadrics about 40 % of its time
+/// (perf, 4.4 M triangles); so did the collapse test on the faces and positions around an edge.
+/// Prefetching took about 5 % (the sweeps) and 9 % (the waves) off the whole simplification of
+/// the 4.4 M mesh, 9 % off the bunny's in a warm process, with identical results (interleaved
+/// runs, see docs/subdivision.md).
 const PREFETCH_AHEAD: usize = 16;
 
-/// Asks the processor to load the cache lines of `x` (a quadric spans two) without waiting
-/// for them. The sweeps over all faces read each corner's quadric and position, which on a
-/// large mesh sit far apart in memory (Morton order keeps most neighbours close, not all), so
-/// they stalled on the loads: the costing of edges waited on its quadrics about 40 % of its
-/// time (perf, 4.4 M triangles); so did the collapse test on the faces and positions around
-/// an edge. Prefetching took about 5 % (the sweeps) and 9 % (the waves) off the whole
-/// simplification of the 4.4 M mesh, 9 % off the bunny's in a warm process, with identical
-/// results (interleaved runs, see docs/subdivision.md). A no-op off x86-64 (the browser
-/// build).
-#[inline]
-fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        let first = (x as *const T).cast::<i8>();
-        let last = first.wrapping_add(std::mem::size_of::<T>().saturating_sub(1));
-        // SAFETY: a prefetch is a hint that never faults nor reads into the program, and SSE
-        // (which provides it) is part of every x86-64 processor.
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(first);
-            _mm_prefetch::<_MM_HINT_T0>(last);
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
 
 /// `n` in compact storage.
 fn compact(n: Vec3) -> [f32; 3] {
