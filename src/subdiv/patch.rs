@@ -12,7 +12,7 @@
 //! share one node, and the sub-patch at an extraordinary vertex maps to itself after the first
 //! step (a self-loop in the graph), as in Stam's eigen-analysis but without eigenvectors.
 
-use super::basis::{bicubic_lattice, PowerBasis, LOOP_LATTICE};
+use super::basis::{bicubic_lattice, rows_times_points, PowerBasis, LOOP_LATTICE};
 use super::topo::{key, EdgeTag, Stencil, Topo, NO};
 use super::{LimitEval, Scheme, SubdivError};
 use crate::geom::{Point3, Vec3};
@@ -284,13 +284,6 @@ fn sparse_times_dense(a: &Sparse, b: &[f64], k: usize) -> Vec<f64> {
         }
     }
     out
-}
-
-/// `out.push(Σ_j mat[r][j] pts[j])` for every row of the row-major `mat` (`pts.len()` columns).
-fn apply_dense(mat: &[f64], pts: &[Point3], out: &mut Vec<Vec3>) {
-    for row in mat.chunks_exact(pts.len().max(1)) {
-        out.push(row.iter().zip(pts).map(|(&w, &p)| p * w).sum());
-    }
 }
 
 /// A canonical neighbourhood of one face: local faces and where each local point came from.
@@ -904,7 +897,9 @@ impl Graph {
     pub fn fill_shortcut(&self, id: u32, pts: &[Point3], out: &mut Vec<Vec3>) {
         for entry in &self.shortcuts[id as usize].entries {
             match entry {
-                Entry::Leaf { mat, .. } | Entry::Deep { mat, .. } => apply_dense(mat, pts, out),
+                Entry::Leaf { mat, .. } | Entry::Deep { mat, .. } => {
+                    rows_times_points(mat, pts, out)
+                }
             }
         }
     }
