@@ -556,6 +556,11 @@ fn unfold(topo: &Topo, scheme: Scheme) -> Option<Vec<Option<(i32, i32)>>> {
 /// where reflected phantom points reproduce the cubic B-spline crease rule exactly. A grid
 /// corner (one face between its sharp edges) is not regular: the crease rule smooths it, while
 /// reflected phantoms would make it interpolate the control vertex.
+///
+/// Note: `n - 1` faces is two triangles or three quads, which no straight crease or boundary
+/// has (three triangles, two quads do), so today such patches are subdivided: exact, but slow
+/// on the edge itself and with inexact second derivatives there. Mending it changes fits and
+/// waits on a frozen-fit problem it exposes (docs/subdivision.md, "Foot points").
 fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
     if !topo.is_complete(c) {
         return false;
