@@ -878,7 +878,6 @@ const PICKS_AHEAD: usize = 2;
 /// runs, see docs/subdivision.md).
 const PREFETCH_AHEAD: usize = 16;
 
-
 /// `n` in compact storage.
 fn compact(n: Vec3) -> [f32; 3] {
     [n.x as f32, n.y as f32, n.z as f32]
