@@ -388,6 +388,38 @@ impl PowerBasis {
     }
 }
 
+/// Appends `Σ_j m[r][j] pts[j]` for every row `r` of the row-major matrix `mat` (rows of
+/// `pts.len()` weights) to `out`.
+///
+/// Each row's sum runs over j in order from zero, as `Iterator::sum` would (so the results are
+/// those bits), but four rows at a time: one row's sum is a chain of dependent additions that
+/// waits on each one's latency, and four independent chains keep the adder busy. This is the
+/// patch-data refill after every move (every irregular patch's shortcut is such a product).
+pub(crate) fn rows_times_points(mat: &[f64], pts: &[Vec3], out: &mut Vec<Vec3>) {
+    let k = pts.len();
+    if k == 0 {
+        out.extend(std::iter::repeat_n(Vec3::ZERO, mat.len()));
+        return;
+    }
+    let mut blocks = mat.chunks_exact(4 * k);
+    for block in &mut blocks {
+        let (r0, rest) = block.split_at(k);
+        let (r1, rest) = rest.split_at(k);
+        let (r2, r3) = rest.split_at(k);
+        let mut acc = [Vec3::ZERO; 4];
+        for (j, &p) in pts.iter().enumerate() {
+            acc[0] += p * r0[j];
+            acc[1] += p * r1[j];
+            acc[2] += p * r2[j];
+            acc[3] += p * r3[j];
+        }
+        out.extend_from_slice(&acc);
+    }
+    for row in blocks.remainder().chunks_exact(k) {
+        out.push(row.iter().zip(pts).map(|(&w, &p)| p * w).sum());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -463,37 +495,5 @@ mod tests {
                 out
             })
             .collect()
-    }
-}
-
-/// Appends `Σ_j m[r][j] pts[j]` for every row `r` of the row-major matrix `mat` (rows of
-/// `pts.len()` weights) to `out`.
-///
-/// Each row's sum runs over j in order from zero, as `Iterator::sum` would (so the results are
-/// those bits), but four rows at a time: one row's sum is a chain of dependent additions that
-/// waits on each one's latency, and four independent chains keep the adder busy. This is the
-/// patch-data refill after every move (every irregular patch's shortcut is such a product).
-pub(crate) fn rows_times_points(mat: &[f64], pts: &[Vec3], out: &mut Vec<Vec3>) {
-    let k = pts.len();
-    if k == 0 {
-        out.extend(std::iter::repeat_n(Vec3::ZERO, mat.len()));
-        return;
-    }
-    let mut blocks = mat.chunks_exact(4 * k);
-    for block in &mut blocks {
-        let (r0, rest) = block.split_at(k);
-        let (r1, rest) = rest.split_at(k);
-        let (r2, r3) = rest.split_at(k);
-        let mut acc = [Vec3::ZERO; 4];
-        for (j, &p) in pts.iter().enumerate() {
-            acc[0] += p * r0[j];
-            acc[1] += p * r1[j];
-            acc[2] += p * r2[j];
-            acc[3] += p * r3[j];
-        }
-        out.extend_from_slice(&acc);
-    }
-    for row in blocks.remainder().chunks_exact(k) {
-        out.push(row.iter().zip(pts).map(|(&w, &p)| p * w).sum());
     }
 }
