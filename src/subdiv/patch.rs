@@ -551,16 +551,19 @@ fn unfold(topo: &Topo, scheme: Scheme) -> Option<Vec<Option<(i32, i32)>>> {
     Some(coords)
 }
 
-/// Whether a corner allows a closed-form patch: smooth with the regular valence, or (quads
-/// only) on a straight crease or boundary: two sharp edges with two faces on the patch's side,
-/// where reflected phantom points reproduce the cubic B-spline crease rule exactly. A grid
-/// corner (one face between its sharp edges) is not regular: the crease rule smooths it, while
-/// reflected phantoms would make it interpolate the control vertex.
+/// Whether a corner allows a closed-form patch: smooth with the regular valence, or on a
+/// straight crease or open boundary: two sharp edges with half the regular valence's faces on
+/// the patch's side (three triangles, two quads), where reflected phantom points reproduce the
+/// cubic B-spline crease rule exactly. A grid corner (one face between its sharp edges) is not
+/// regular: the crease rule smooths it, while reflected phantoms would make it interpolate the
+/// control vertex.
 ///
-/// Note: `n - 1` faces is two triangles or three quads, which no straight crease or boundary
-/// has (three triangles, two quads do), so today such patches are subdivided: exact, but slow
-/// on the edge itself and with inexact second derivatives there. Mending it changes fits and
-/// waits on a frozen-fit problem it exposes (docs/subdivision.md, "Foot points").
+/// Until 2026-12-07 this asked for two triangles or three quads, which no straight crease or
+/// boundary has, so every patch along one was evaluated by subdividing towards it: correct,
+/// but a point on the edge itself went 40 levels deep (about a quarter of the warm foot points'
+/// time on the bunny, whose holes leave ~100 points on open edges, and 29 % of a Loop fit of
+/// the range scan bun000), and its second derivatives, scaled back from 2⁻⁴⁰, were off by up to
+/// 1 % (`tests/common/surface_checks.rs` now checks them along creases and boundaries).
 fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
     if !topo.is_complete(c) {
         return false;
@@ -574,8 +577,10 @@ fn corner_is_regular(topo: &Topo, scheme: Scheme, c: u32) -> bool {
             topo.vertex_edges(c).len() == valence && fan.iter().all(|&g| topo.face(g).len() == n)
         }
         2 => {
+            // Half the regular valence on each side: 3 triangles or 2 quads.
+            let side = if n == 3 { 3 } else { 2 };
             topo.fan(c, 0, true, &mut fan);
-            fan.len() == n - 1 && fan.iter().all(|&g| topo.face(g).len() == n)
+            fan.len() == side && fan.iter().all(|&g| topo.face(g).len() == n)
         }
         _ => false,
     }
