@@ -281,8 +281,9 @@ pub struct SubdivFitter<S: ControlSurface> {
     /// the moves (see [`SubdivFitter::back_rows`]).
     pulls: Vec<(SurfaceParam, Point3)>,
     pull_weight: f64,
-    /// A factor on [`PULL_BACK`]: halved after every move that the damping undid while samples
-    /// were pulled, doubled back (up to 1) after every move kept ([`SubdivFitter::ease_pull`]).
+    /// A factor on [`PULL_BACK`]: halved after every move that the damping of
+    /// [`SubdivFitter::move_control_points`] undid while samples were pulled, doubled back (up
+    /// to 1) after every move kept ([`SubdivFitter::ease_pull`]).
     pull_scale: f64,
     /// Surface samples a move threw off the data, held since at the data point nearest to
     /// where they were before it ([`SubdivFitter::damp_back_jump`]), until a refinement
@@ -773,16 +774,10 @@ impl<S: ControlSurface> SubdivFitter<S> {
         self.phases.add(|p| &mut p.refill_ms, started);
     }
 
-    /// Whether E_max rose by more than [`MAX_JUMP`] from `before` past its tolerance while
-    /// points are pulled ([`SubdivFitter::adapt_point_weights`]) or surface samples are
-    /// ([`SubdivFitter::pulls`], [`SubdivFitter::holds`]): the weighted objective the damping
-    /// judges can fall while the heavy points drag their neighbours off (the bunny at Table 1
-    /// model C went from E_max 0.050 to 0.41 % in one such move), or while the samples pulled
-    /// towards the data drag the surface off other data (the same fit, E_max 0.049 → 0.40 %
-    /// with E_back 0.36 → 0.14 %), which defeats what the pull is for.
-    /// Pulls more gently after a move the damping undid while samples were pulled, and back
-    /// to full strength as moves are kept. A pull towards the data can drag the surface off
-    /// other data (E_max past its tolerance), and then every move is undone: the teapot with
+    /// Pulls more gently after a move the damping of [`SubdivFitter::move_control_points`]
+    /// undid while samples were pulled, and back to full strength as moves are kept. A pull
+    /// towards the data can drag the surface off other data (E_max past its tolerance), and
+    /// then every move is undone: the teapot with
     /// creases at the defaults had E_avg and E_max met and a sheet 1.85 % off the data, and
     /// each move halved the objective but threw E_max from 0.50 to 0.79–0.97 %, nine times in
     /// a row, until the fit stalled in place.
@@ -796,6 +791,13 @@ impl<S: ControlSurface> SubdivFitter<S> {
         };
     }
 
+    /// Whether E_max rose by more than [`MAX_JUMP`] from `before` past its tolerance while
+    /// points are pulled ([`SubdivFitter::adapt_point_weights`]) or surface samples are
+    /// ([`SubdivFitter::pulls`], [`SubdivFitter::holds`]): the weighted objective the damping
+    /// judges can fall while the heavy points drag their neighbours off (the bunny at Table 1
+    /// model C went from E_max 0.050 to 0.41 % in one such move), or while the samples pulled
+    /// towards the data drag the surface off other data (the same fit, E_max 0.049 → 0.40 %
+    /// with E_back 0.36 → 0.14 %), which defeats what the pull is for.
     fn max_jumped(&self, before: &ErrorStats) -> bool {
         let pulling = self.point_weights.iter().any(|&w| w > 1.0)
             || !self.pulls.is_empty()
